@@ -1,0 +1,54 @@
+//! # imesh-geom
+//!
+//! The geometry kernel of imesh: exact predicates, and a Delaunay triangulation built for image
+//! meshing, where pixel centres make cocircular and collinear points the normal case.
+//!
+//! - [`predicates`]: Shewchuk's adaptive exact `orient2d` / `incircle` (through `robust`), used for
+//!   every geometric decision.
+//! - [`Triangulation`]: index-based half-edges with ghost triangles; incremental Bowyer–Watson
+//!   insertion that reports the triangles it created; bulk construction in a Hilbert-sorted biased
+//!   randomised order; point location by a remembering stochastic walk; and [`Triangulation::check`],
+//!   which verifies everything (including the empty-circle property) with exact predicates.
+//! - [`spatial_sort`]: the insertion orders.
+//!
+//! ```
+//! use imesh_geom::{Point, Triangulation};
+//!
+//! let mut points = Vec::new();
+//! for row in 0..50 {
+//!     for col in 0..80 {
+//!         points.push(Point::pixel_centre(col, row));
+//!     }
+//! }
+//! let (tri, _) = Triangulation::from_points(&points)?;
+//! tri.check()?;
+//! let hull = tri.hull().len();
+//! assert_eq!(tri.num_triangles(), 2 * points.len() - hull - 2);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod predicates;
+pub mod spatial_sort;
+
+mod point;
+mod triangulation;
+
+pub use point::Point;
+pub use triangulation::{
+    HalfEdgeId, Location, TriangleId, Triangulation, TriangulationDefect, VertexId,
+};
+
+/// Errors of the geometry kernel.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum GeomError {
+    /// A point has a NaN or infinite coordinate.
+    #[error("point {index} has a non-finite coordinate ({x}, {y}): give finite coordinates")]
+    NonFinitePoint {
+        /// Index of the point in the input.
+        index: usize,
+        /// Its x coordinate.
+        x: f64,
+        /// Its y coordinate.
+        y: f64,
+    },
+}

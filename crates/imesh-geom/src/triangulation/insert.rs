@@ -1,0 +1,429 @@
+//! Point location and Bowyer–Watson insertion.
+//!
+//! To insert `p`: walk to the triangle that holds it, then dig the *cavity* — every triangle whose
+//! open circumdisk holds `p` (for a ghost triangle: `p` strictly beyond its hull edge, or on the open
+//! edge). The cavity is a topological disk with all its vertices on its boundary and `p` strictly
+//! inside its kernel, so joining `p` to each boundary edge re-triangulates it, and the result is
+//! Delaunay again. Using the *open* disk is what makes pixel grids cheap: a cocircular point does not
+//! enlarge the cavity.
+//!
+//! The cavity's dual graph is a tree (no vertex inside the disk), so a depth-first search that visits
+//! each triangle's edges counter-clockwise meets the boundary edges in counter-clockwise order: the new
+//! triangles can be linked to each other without any lookup.
+
+use std::collections::HashMap;
+use std::sync::atomic::Ordering;
+
+use super::{next, HalfEdgeId, TriangleId, Triangulation, VertexId, GHOST, NONE};
+use crate::predicates::{incircle, orient2d, strictly_between};
+use crate::{GeomError, Point};
+
+/// Where a point lies in a [`Triangulation`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Location {
+    /// On an existing vertex.
+    OnVertex(VertexId),
+    /// On the interior of an edge; the half-edge belongs to a real triangle holding the point.
+    OnEdge(HalfEdgeId),
+    /// Strictly inside a triangle.
+    InTriangle(TriangleId),
+    /// Outside the convex hull, strictly beyond the given hull half-edge (of a real triangle).
+    OutsideHull(HalfEdgeId),
+    /// The triangulation has no triangles yet (fewer than three non-collinear vertices).
+    NoTriangles,
+}
+
+/// Reusable buffers for the cavity search.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    stack: Vec<u32>,
+    cavity: Vec<u32>,
+    /// Boundary edges of the cavity, counter-clockwise: (origin vertex, outside half-edge).
+    boundary: Vec<(u32, u32)>,
+    /// Deduplication of the pending (collinear) vertices.
+    pending_index: HashMap<(u64, u64), u32>,
+}
+
+/// Result of a visibility walk.
+enum Walk {
+    /// A real triangle holding the point (inside or on its boundary).
+    Inside(u32),
+    /// A ghost triangle whose hull edge has the point strictly beyond it.
+    Outside(u32),
+}
+
+/// Result of inserting a stored vertex.
+enum Inserted {
+    New,
+    Duplicate(u32),
+}
+
+/// Exact bits of a point, with −0 and +0 identified, for duplicate lookup.
+fn point_key(p: Point) -> (u64, u64) {
+    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+}
+
+impl Triangulation {
+    /// Builds the Delaunay triangulation of `points`.
+    ///
+    /// Points are inserted in a biased randomised order along a Hilbert curve, which keeps every
+    /// walk short; 10^6 points take well under a second. Duplicate points become one vertex. Returns
+    /// the triangulation and, for each input point, its vertex: vertex ids follow the input order of
+    /// the distinct points.
+    ///
+    /// # Errors
+    /// [`GeomError::NonFinitePoint`] when a coordinate is NaN or infinite.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(4.0, 0.0), Point::new(0.0, 0.0), Point::new(0.0, 3.0)];
+    /// let (t, ids) = Triangulation::from_points(&pts).unwrap();
+    /// assert_eq!(t.num_vertices(), 3);
+    /// assert_eq!(ids[2], ids[0]);
+    /// assert_eq!(t.point(ids[3]), Point::new(0.0, 3.0));
+    /// ```
+    pub fn from_points(points: &[Point]) -> Result<(Self, Vec<VertexId>), GeomError> {
+        validate(points)?;
+        let mut tri = Self::with_capacity(points.len());
+        tri.points.extend_from_slice(points);
+        tri.out_edge.resize(points.len(), NONE);
+        let mut duplicates = Vec::new();
+        for i in crate::spatial_sort::brio_order(points) {
+            if let Inserted::Duplicate(j) = tri.insert_vertex(i) {
+                duplicates.push((i, j));
+            }
+        }
+        let ids = tri.remove_duplicate_vertices(&duplicates);
+        tri.created.clear();
+        Ok((tri, ids))
+    }
+
+    /// Inserts `p` and returns its vertex, or the existing vertex at exactly the same position.
+    ///
+    /// The triangles this insertion created are then listed by
+    /// [`created_triangles`](Self::created_triangles).
+    ///
+    /// # Errors
+    /// [`GeomError::NonFinitePoint`] when a coordinate is NaN or infinite.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let mut t = Triangulation::new();
+    /// for p in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)] {
+    ///     t.insert(p.into()).unwrap();
+    /// }
+    /// let v = t.insert(Point::new(0.25, 0.25)).unwrap();
+    /// assert_eq!(t.created_triangles().len(), 3); // the old triangle split in three
+    /// assert_eq!(t.insert(Point::new(0.25, 0.25)).unwrap(), v);
+    /// ```
+    pub fn insert(&mut self, p: Point) -> Result<VertexId, GeomError> {
+        validate(std::slice::from_ref(&p))?;
+        let v = self.points.len() as u32;
+        self.points.push(p);
+        self.out_edge.push(NONE);
+        self.created.clear();
+        match self.insert_vertex(v) {
+            Inserted::New => Ok(VertexId(v)),
+            Inserted::Duplicate(u) => {
+                self.points.pop();
+                self.out_edge.pop();
+                Ok(VertexId(u))
+            }
+        }
+    }
+
+    /// The real triangles created by the last [`insert`](Self::insert) (they replace the triangles
+    /// whose circumcircle held the new point). Empty after [`from_points`](Self::from_points).
+    pub fn created_triangles(&self) -> &[TriangleId] {
+        &self.created
+    }
+
+    /// Locates `p`, walking from the triangle of the last insertion or location.
+    ///
+    /// ```
+    /// use imesh_geom::{Location, Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(2.0, 0.0), Point::new(0.0, 2.0)];
+    /// let (t, ids) = Triangulation::from_points(&pts).unwrap();
+    /// assert!(matches!(t.locate(Point::new(0.5, 0.5)), Location::InTriangle(_)));
+    /// assert!(matches!(t.locate(Point::new(1.0, 1.0)), Location::OnEdge(_)));
+    /// assert_eq!(t.locate(Point::new(2.0, 0.0)), Location::OnVertex(ids[1]));
+    /// assert!(matches!(t.locate(Point::new(3.0, 3.0)), Location::OutsideHull(_)));
+    /// ```
+    pub fn locate(&self, p: Point) -> Location {
+        if self.is_degenerate() {
+            return Location::NoTriangles;
+        }
+        match self.walk(p) {
+            Walk::Outside(g) => Location::OutsideHull(HalfEdgeId(self.twin[self.ghost_real_edge(g) as usize])),
+            Walk::Inside(t) => {
+                for e in 3 * t..3 * t + 3 {
+                    let a = self.origin[e as usize];
+                    if self.points[a as usize] == p {
+                        return Location::OnVertex(VertexId(a));
+                    }
+                }
+                for e in 3 * t..3 * t + 3 {
+                    let (a, b) = (self.origin[e as usize], self.origin[next(e) as usize]);
+                    if orient2d(self.points[a as usize], self.points[b as usize], p) == 0.0 {
+                        return Location::OnEdge(HalfEdgeId(e));
+                    }
+                }
+                Location::InTriangle(TriangleId(t))
+            }
+        }
+    }
+
+    /// A real triangle to start walking from.
+    fn start_triangle(&self) -> u32 {
+        let mut t = self.hint.load(Ordering::Relaxed);
+        if 3 * t as usize >= self.origin.len() {
+            t = 0;
+        }
+        if self.is_ghost_slot(t) {
+            t = self.twin[self.ghost_real_edge(t) as usize] / 3;
+        }
+        t
+    }
+
+    /// Visibility walk: cross any edge that has `p` strictly on its far side until none does. The
+    /// edge tried first is drawn pseudo-randomly, which makes the walk terminate on any
+    /// triangulation, not only Delaunay ones (Devillers–Pion–Teillaud).
+    fn walk(&self, p: Point) -> Walk {
+        let mut t = self.start_triangle();
+        let mut entered = NONE;
+        let mut rng = t.wrapping_mul(0x9e37_79b9) ^ (p.x.to_bits() as u32);
+        'step: loop {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            let r = rng % 3;
+            for k in 0..3 {
+                let e = 3 * t + (r + k) % 3;
+                if e == entered {
+                    continue;
+                }
+                let a = self.points[self.origin[e as usize] as usize];
+                let b = self.points[self.origin[next(e) as usize] as usize];
+                if orient2d(a, b, p) < 0.0 {
+                    let o = self.twin[e as usize];
+                    let nt = o / 3;
+                    if self.is_ghost_slot(nt) {
+                        self.hint.store(t, Ordering::Relaxed);
+                        return Walk::Outside(nt);
+                    }
+                    entered = o;
+                    t = nt;
+                    continue 'step;
+                }
+            }
+            self.hint.store(t, Ordering::Relaxed);
+            return Walk::Inside(t);
+        }
+    }
+
+    /// True when triangle `t` (real or ghost) must be destroyed by inserting `p`.
+    #[inline]
+    fn in_cavity(&self, t: u32, p: Point) -> bool {
+        let b = 3 * t as usize;
+        let (a, bb, c) = (self.origin[b], self.origin[b + 1], self.origin[b + 2]);
+        let pt = |v: u32| self.points[v as usize];
+        let beyond_hull_edge = |u: u32, w: u32| {
+            // Ghost (u, w, GHOST): the real triangle lies right of u → w, the outside to its left.
+            let o = orient2d(pt(u), pt(w), p);
+            o > 0.0 || (o == 0.0 && strictly_between(pt(u), pt(w), p))
+        };
+        if c == GHOST {
+            beyond_hull_edge(a, bb)
+        } else if a == GHOST {
+            beyond_hull_edge(bb, c)
+        } else if bb == GHOST {
+            beyond_hull_edge(c, a)
+        } else {
+            incircle(pt(a), pt(bb), pt(c), p) > 0.0
+        }
+    }
+
+    /// Inserts the stored vertex `v`.
+    fn insert_vertex(&mut self, v: u32) -> Inserted {
+        if self.is_degenerate() {
+            return self.insert_collinear(v);
+        }
+        let p = self.points[v as usize];
+        let seed = match self.walk(p) {
+            Walk::Outside(g) => g,
+            Walk::Inside(t) => {
+                for e in 3 * t..3 * t + 3 {
+                    let a = self.origin[e as usize];
+                    if self.points[a as usize] == p {
+                        return Inserted::Duplicate(a);
+                    }
+                }
+                t
+            }
+        };
+        self.dig_cavity(seed, p);
+        self.fill_cavity(v);
+        Inserted::New
+    }
+
+    /// Collects the cavity of `p` grown from `seed`, and its boundary in counter-clockwise order.
+    fn dig_cavity(&mut self, seed: u32, p: Point) {
+        let mut s = std::mem::take(&mut self.scratch);
+        s.cavity.clear();
+        s.boundary.clear();
+        s.stack.clear();
+        s.cavity.push(seed);
+        s.stack.extend([3 * seed + 2, 3 * seed + 1, 3 * seed]);
+        while let Some(e) = s.stack.pop() {
+            let o = self.twin[e as usize];
+            let t = o / 3;
+            if self.in_cavity(t, p) {
+                s.cavity.push(t);
+                let n1 = next(o);
+                s.stack.push(next(n1));
+                s.stack.push(n1);
+            } else {
+                s.boundary.push((self.origin[e as usize], o));
+            }
+        }
+        self.scratch = s;
+    }
+
+    /// Replaces the cavity by the fan of triangles joining `v` to its boundary.
+    fn fill_cavity(&mut self, v: u32) {
+        let mut s = std::mem::take(&mut self.scratch);
+        let m = s.boundary.len();
+        debug_assert_eq!(m, s.cavity.len() + 2);
+        let ghosts_removed = s.cavity.iter().filter(|&&t| self.is_ghost_slot(t)).count();
+        for _ in 0..m - s.cavity.len() {
+            s.cavity.push((self.origin.len() / 3) as u32);
+            self.origin.extend([0; 3]);
+            self.twin.extend([0; 3]);
+        }
+        let mut ghosts_added = 0;
+        self.created.clear();
+        for i in 0..m {
+            let t = s.cavity[i];
+            let (x, outside) = s.boundary[i];
+            let y = s.boundary[(i + 1) % m].0;
+            let tn = s.cavity[(i + 1) % m];
+            let b = 3 * t as usize;
+            self.origin[b] = x;
+            self.origin[b + 1] = y;
+            self.origin[b + 2] = v;
+            self.twin[b] = outside;
+            self.twin[outside as usize] = 3 * t;
+            // (y → v) here is the twin of (v → y) in the next triangle of the fan.
+            self.twin[b + 1] = 3 * tn + 2;
+            self.twin[3 * tn as usize + 2] = 3 * t + 1;
+            if x != GHOST {
+                self.out_edge[x as usize] = 3 * t;
+            }
+            if x == GHOST || y == GHOST {
+                ghosts_added += 1;
+            } else {
+                self.created.push(TriangleId(t));
+            }
+        }
+        self.out_edge[v as usize] = 3 * s.cavity[0] + 2;
+        self.ghost_count = self.ghost_count + ghosts_added - ghosts_removed;
+        if let Some(t) = self.created.first() {
+            self.hint.store(t.0, Ordering::Relaxed);
+        }
+        self.scratch = s;
+    }
+
+    /// Insertion while all vertices so far are collinear: keep the vertex pending until a point off
+    /// their line arrives, then build the first triangle and insert the pending vertices into it.
+    fn insert_collinear(&mut self, v: u32) -> Inserted {
+        let p = self.points[v as usize];
+        if let Some(&u) = self.scratch.pending_index.get(&point_key(p)) {
+            return Inserted::Duplicate(u);
+        }
+        if let [a, b, ..] = self.pending[..] {
+            let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
+            let o = orient2d(pa, pb, p);
+            if o != 0.0 {
+                let (a, b) = if o > 0.0 { (a, b) } else { (b, a) };
+                self.first_triangle(a, b, v);
+                let pending = std::mem::take(&mut self.pending);
+                self.scratch.pending_index = HashMap::new();
+                for &u in &pending[2..] {
+                    self.insert_vertex(u);
+                }
+                self.created = self.triangles().collect();
+                return Inserted::New;
+            }
+        }
+        self.pending.push(v);
+        self.scratch.pending_index.insert(point_key(p), v);
+        Inserted::New
+    }
+
+    /// The counter-clockwise triangle `a b c` and its three ghosts.
+    fn first_triangle(&mut self, a: u32, b: u32, c: u32) {
+        // Slot 0: (a, b, c). Slots 1–3: ghosts (b, a, G), (c, b, G), (a, c, G).
+        self.origin = vec![a, b, c, b, a, GHOST, c, b, GHOST, a, c, GHOST];
+        self.twin = vec![3, 6, 9, 0, 11, 7, 1, 5, 10, 2, 8, 4];
+        self.out_edge[a as usize] = 0;
+        self.out_edge[b as usize] = 1;
+        self.out_edge[c as usize] = 2;
+        self.ghost_count = 3;
+        self.hint.store(0, Ordering::Relaxed);
+    }
+
+    /// Drops the vertices that duplicated an earlier one (pairs `(duplicate, kept)`), renumbering
+    /// the rest densely in their original order. Returns the vertex of every original index.
+    fn remove_duplicate_vertices(&mut self, duplicates: &[(u32, u32)]) -> Vec<VertexId> {
+        let n = self.points.len();
+        if duplicates.is_empty() {
+            return (0..n as u32).map(VertexId).collect();
+        }
+        let mut is_dup = vec![false; n];
+        for &(d, _) in duplicates {
+            is_dup[d as usize] = true;
+        }
+        let mut new_id = vec![NONE; n];
+        let mut next_id = 0u32;
+        for (old, dup) in is_dup.iter().enumerate() {
+            if !dup {
+                new_id[old] = next_id;
+                next_id += 1;
+            }
+        }
+        for &(d, kept) in duplicates {
+            new_id[d as usize] = new_id[kept as usize];
+        }
+        for o in &mut self.origin {
+            if *o != GHOST {
+                *o = new_id[*o as usize];
+            }
+        }
+        for p in &mut self.pending {
+            *p = new_id[*p as usize];
+        }
+        let mut keep = is_dup.iter().map(|d| !d);
+        self.points.retain(|_| keep.next().unwrap_or(false));
+        let mut keep = is_dup.iter().map(|d| !d);
+        self.out_edge.retain(|_| keep.next().unwrap_or(false));
+        if !self.scratch.pending_index.is_empty() {
+            self.scratch.pending_index = self
+                .pending
+                .iter()
+                .map(|&v| (point_key(self.points[v as usize]), v))
+                .collect();
+        }
+        new_id.into_iter().map(VertexId).collect()
+    }
+}
+
+fn validate(points: &[Point]) -> Result<(), GeomError> {
+    match points.iter().position(|p| !p.is_finite()) {
+        Some(index) => Err(GeomError::NonFinitePoint {
+            index,
+            x: points[index].x,
+            y: points[index].y,
+        }),
+        None => Ok(()),
+    }
+}
