@@ -1,1 +1,75 @@
-fn main(){}
+//! `cargo xtask`: project automation for imesh, in Rust (no shell scripts).
+//!
+//! ```text
+//! cargo xtask bench delaunay [--runs N] [--quick]
+//! ```
+
+mod alloc;
+mod bench_delaunay;
+
+use std::process::ExitCode;
+
+const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
+
+  bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
+                   writes target/bench/delaunay.json
+    --runs N       timed runs per input and implementation (median reported; default 7)
+    --quick        smaller inputs (10^4, 10^5 points, 316x316 grid) for a fast check";
+
+#[global_allocator]
+static ALLOCATOR: alloc::CountingAllocator = alloc::CountingAllocator;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("error: {msg}\n\n{USAGE}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(args: &[String]) -> Result<(), String> {
+    let words: Vec<&str> = args.iter().map(String::as_str).collect();
+    match words.as_slice() {
+        ["bench", "delaunay", rest @ ..] => {
+            let mut options = bench_delaunay::Options::default();
+            let mut it = rest.iter();
+            while let Some(&flag) = it.next() {
+                match flag {
+                    "--quick" => options.quick = true,
+                    "--runs" => {
+                        let n = it.next().ok_or("--runs needs a number")?;
+                        options.runs = n
+                            .parse()
+                            .ok()
+                            .filter(|&r: &usize| r > 0)
+                            .ok_or_else(|| format!("--runs takes a positive integer, not '{n}'"))?;
+                    }
+                    other => return Err(format!("unknown option '{other}'")),
+                }
+            }
+            bench_delaunay::run(&options)
+        }
+        [] | ["help"] | ["--help"] | ["-h"] => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        _ => Err(format!("unknown command '{}'", words.join(" "))),
+    }
+}
+
+/// `target/bench/` of the workspace (created if needed).
+pub fn bench_dir() -> Result<std::path::PathBuf, String> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .ok_or("xtask is not inside the workspace")?
+        .to_path_buf();
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
+    let dir = target.join("bench");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    Ok(dir)
+}

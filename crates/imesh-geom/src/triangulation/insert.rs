@@ -84,16 +84,19 @@ impl Triangulation {
     /// ```
     pub fn from_points(points: &[Point]) -> Result<(Self, Vec<VertexId>), GeomError> {
         validate(points)?;
+        // Build with vertices numbered in insertion order, so that the points of neighbouring
+        // vertices are neighbours in memory; renumber to input order once at the end.
+        let order = crate::spatial_sort::brio_order(points);
         let mut tri = Self::with_capacity(points.len());
-        tri.points.extend_from_slice(points);
+        tri.points.extend(order.iter().map(|&i| points[i as usize]));
         tri.out_edge.resize(points.len(), NONE);
         let mut duplicates = Vec::new();
-        for i in crate::spatial_sort::brio_order(points) {
-            if let Inserted::Duplicate(j) = tri.insert_vertex(i) {
-                duplicates.push((i, j));
+        for rank in 0..points.len() as u32 {
+            if let Inserted::Duplicate(kept) = tri.insert_vertex(rank) {
+                duplicates.push((rank, kept));
             }
         }
-        let ids = tri.remove_duplicate_vertices(&duplicates);
+        let ids = tri.renumber_to_input_order(&order, &duplicates);
         tri.created.clear();
         Ok((tri, ids))
     }
@@ -372,27 +375,27 @@ impl Triangulation {
         self.hint.store(0, Ordering::Relaxed);
     }
 
-    /// Drops the vertices that duplicated an earlier one (pairs `(duplicate, kept)`), renumbering
-    /// the rest densely in their original order. Returns the vertex of every original index.
-    fn remove_duplicate_vertices(&mut self, duplicates: &[(u32, u32)]) -> Vec<VertexId> {
-        let n = self.points.len();
-        if duplicates.is_empty() {
-            return (0..n as u32).map(VertexId).collect();
+    /// After a bulk build in which vertex `rank` is input point `order[rank]`: drops the vertices
+    /// that duplicated another (pairs `(duplicate, kept)`, as ranks) and renumbers the rest densely
+    /// in input order. Returns the vertex of every input point.
+    fn renumber_to_input_order(&mut self, order: &[u32], duplicates: &[(u32, u32)]) -> Vec<VertexId> {
+        let n = order.len();
+        let mut dropped = vec![false; n]; // by input index
+        for &(rank, _) in duplicates {
+            dropped[order[rank as usize] as usize] = true;
         }
-        let mut is_dup = vec![false; n];
-        for &(d, _) in duplicates {
-            is_dup[d as usize] = true;
-        }
-        let mut new_id = vec![NONE; n];
+        let mut id_of_input = vec![NONE; n];
         let mut next_id = 0u32;
-        for (old, dup) in is_dup.iter().enumerate() {
-            if !dup {
-                new_id[old] = next_id;
+        for (input, &gone) in dropped.iter().enumerate() {
+            if !gone {
+                id_of_input[input] = next_id;
                 next_id += 1;
             }
         }
-        for &(d, kept) in duplicates {
-            new_id[d as usize] = new_id[kept as usize];
+        let mut new_id: Vec<u32> = order.iter().map(|&i| id_of_input[i as usize]).collect();
+        for &(rank, kept) in duplicates {
+            new_id[rank as usize] = new_id[kept as usize];
+            id_of_input[order[rank as usize] as usize] = new_id[kept as usize];
         }
         for o in &mut self.origin {
             if *o != GHOST {
@@ -402,10 +405,18 @@ impl Triangulation {
         for p in &mut self.pending {
             *p = new_id[*p as usize];
         }
-        let mut keep = is_dup.iter().map(|d| !d);
-        self.points.retain(|_| keep.next().unwrap_or(false));
-        let mut keep = is_dup.iter().map(|d| !d);
-        self.out_edge.retain(|_| keep.next().unwrap_or(false));
+        let distinct = next_id as usize;
+        let mut points = vec![Point::default(); distinct];
+        let mut out_edge = vec![NONE; distinct];
+        for rank in 0..n {
+            let id = new_id[rank] as usize;
+            if !dropped[order[rank] as usize] {
+                points[id] = self.points[rank];
+                out_edge[id] = self.out_edge[rank];
+            }
+        }
+        self.points = points;
+        self.out_edge = out_edge;
         if !self.scratch.pending_index.is_empty() {
             self.scratch.pending_index = self
                 .pending
@@ -413,7 +424,7 @@ impl Triangulation {
                 .map(|&v| (point_key(self.points[v as usize]), v))
                 .collect();
         }
-        new_id.into_iter().map(VertexId).collect()
+        id_of_input.into_iter().map(VertexId).collect()
     }
 }
 
