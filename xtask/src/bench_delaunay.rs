@@ -22,7 +22,10 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Self { runs: 7, quick: false }
+        Self {
+            runs: 7,
+            quick: false,
+        }
     }
 }
 
@@ -86,7 +89,10 @@ fn delaunator(points: &[delaunator::Point]) -> usize {
 }
 
 fn bench_input(name: &str, points: &[Point], runs: usize) -> Row {
-    let spade_pts: Vec<spade::Point2<f64>> = points.iter().map(|p| spade::Point2::new(p.x, p.y)).collect();
+    let spade_pts: Vec<spade::Point2<f64>> = points
+        .iter()
+        .map(|p| spade::Point2::new(p.x, p.y))
+        .collect();
     let del_pts: Vec<delaunator::Point> = points
         .iter()
         .map(|p| delaunator::Point { x: p.x, y: p.y })
@@ -117,7 +123,8 @@ fn bench_input(name: &str, points: &[Point], runs: usize) -> Row {
     let (_, b_ours) = peak_during(|| ours(points));
     let (_, b_spade) = peak_during(|| spade(spade_pts.clone()));
     // The clone handed to spade is its input, not its working memory.
-    let b_spade = b_spade.saturating_sub(spade_pts.len() * std::mem::size_of::<spade::Point2<f64>>());
+    let b_spade =
+        b_spade.saturating_sub(spade_pts.len() * std::mem::size_of::<spade::Point2<f64>>());
     let (_, b_del) = peak_during(|| delaunator(&del_pts));
     let median_s = Timings {
         ours: median(t_ours),
@@ -155,7 +162,14 @@ pub fn run(options: &Options) -> Result<(), String> {
     let mut rows = Vec::new();
     println!(
         "{:<22} {:>9} {:>10} {:>10} {:>10} {:>11} {:>11} {:>16}",
-        "input", "points", "ours s", "spade s", "delaun. s", "ours/spade", "ours/delau", "bytes/vertex o/s/d"
+        "input",
+        "points",
+        "ours s",
+        "spade s",
+        "delaun. s",
+        "ours/spade",
+        "ours/delau",
+        "bytes/vertex o/s/d"
     );
     for (name, points) in &inputs {
         let r = bench_input(name, points, options.runs);

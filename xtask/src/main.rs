@@ -41,11 +41,10 @@ fn run(args: &[String]) -> Result<(), String> {
                     "--quick" => options.quick = true,
                     "--runs" => {
                         let n = it.next().ok_or("--runs needs a number")?;
-                        options.runs = n
-                            .parse()
-                            .ok()
-                            .filter(|&r: &usize| r > 0)
-                            .ok_or_else(|| format!("--runs takes a positive integer, not '{n}'"))?;
+                        options.runs =
+                            n.parse().ok().filter(|&r: &usize| r > 0).ok_or_else(|| {
+                                format!("--runs takes a positive integer, not '{n}'")
+                            })?;
                     }
                     other => return Err(format!("unknown option '{other}'")),
                 }

@@ -41,7 +41,10 @@ fn hilbert_key(mut x: u32, mut y: u32) -> u32 {
 
 /// Hilbert keys of all points, on a grid spanning their bounding box.
 fn hilbert_keys(points: &[Point]) -> Vec<u32> {
-    let (mut lo, mut hi) = (Point::new(f64::MAX, f64::MAX), Point::new(f64::MIN, f64::MIN));
+    let (mut lo, mut hi) = (
+        Point::new(f64::MAX, f64::MAX),
+        Point::new(f64::MIN, f64::MIN),
+    );
     for p in points {
         lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
         hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
@@ -171,7 +174,9 @@ mod tests {
         let order = brio_order(&pts);
         // The last round holds 7/8 of the points and is sorted by key.
         let last = &order[order.len() / 8..];
-        assert!(last.windows(2).all(|w| keys[w[0] as usize] <= keys[w[1] as usize]));
+        assert!(last
+            .windows(2)
+            .all(|w| keys[w[0] as usize] <= keys[w[1] as usize]));
         // The order is not a plain curve order: early rounds sample the whole grid.
         let first: Vec<u32> = order[..BRIO_FIRST_ROUND].to_vec();
         let spread = first.iter().map(|&i| pts[i as usize].y).fold(0.0, f64::max);

@@ -31,20 +31,30 @@ fn hull_boundary_count(points: &[Point]) -> usize {
 }
 
 fn distinct(points: &[Point]) -> usize {
-    let mut p: Vec<(u64, u64)> = points.iter().map(|p| ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())).collect();
+    let mut p: Vec<(u64, u64)> = points
+        .iter()
+        .map(|p| ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits()))
+        .collect();
     p.sort_unstable();
     p.dedup();
     p.len()
 }
 
 fn all_collinear(points: &[Point]) -> bool {
-    let Some(&a) = points.first() else { return true };
-    let Some(&b) = points.iter().find(|&&q| q != a) else { return true };
+    let Some(&a) = points.first() else {
+        return true;
+    };
+    let Some(&b) = points.iter().find(|&&q| q != a) else {
+        return true;
+    };
     points.iter().all(|&q| orient2d(a, b, q) == 0.0)
 }
 
 fn spade_triangle_count(points: &[Point]) -> usize {
-    let v: Vec<spade::Point2<f64>> = points.iter().map(|p| spade::Point2::new(p.x, p.y)).collect();
+    let v: Vec<spade::Point2<f64>> = points
+        .iter()
+        .map(|p| spade::Point2::new(p.x, p.y))
+        .collect();
     let t = spade::DelaunayTriangulation::<spade::Point2<f64>>::bulk_load(v).unwrap();
     t.num_inner_faces()
 }
@@ -57,7 +67,11 @@ fn assert_delaunay_of(points: &[Point]) {
     assert_eq!(t.num_vertices(), n);
     assert_eq!(ids.len(), points.len());
     for (i, v) in ids.iter().enumerate() {
-        assert_eq!(t.point(*v), points[i], "input {i} maps to a vertex at its own position");
+        assert_eq!(
+            t.point(*v),
+            points[i],
+            "input {i} maps to a vertex at its own position"
+        );
     }
     if all_collinear(points) {
         assert_eq!(t.num_triangles(), 0);
@@ -75,18 +89,27 @@ fn assert_globally_delaunay(t: &Triangulation) {
     for f in t.triangles() {
         let [a, b, c] = t.triangle_points(f);
         for v in t.vertices() {
-            assert!(incircle(a, b, c, t.point(v)) <= 0.0, "vertex {v:?} inside triangle {f:?}'s circle");
+            assert!(
+                incircle(a, b, c, t.point(v)) <= 0.0,
+                "vertex {v:?} inside triangle {f:?}'s circle"
+            );
         }
     }
 }
 
 fn grid(w: u32, h: u32) -> Vec<Point> {
-    (0..h).flat_map(|r| (0..w).map(move |c| Point::pixel_centre(c, r))).collect()
+    (0..h)
+        .flat_map(|r| (0..w).map(move |c| Point::pixel_centre(c, r)))
+        .collect()
 }
 
 #[test]
 fn single_triangle_and_its_orientation() {
-    let pts = [Point::new(0.0, 0.0), Point::new(0.0, 1.0), Point::new(1.0, 0.0)];
+    let pts = [
+        Point::new(0.0, 0.0),
+        Point::new(0.0, 1.0),
+        Point::new(1.0, 0.0),
+    ];
     let (t, _) = Triangulation::from_points(&pts).unwrap();
     assert_eq!(t.num_triangles(), 1);
     let f = t.triangles().next().unwrap();
@@ -101,7 +124,10 @@ fn empty_one_and_two_points() {
     for n in 0..3 {
         let pts: Vec<Point> = (0..n).map(|i| Point::new(f64::from(i), 0.0)).collect();
         let (t, ids) = Triangulation::from_points(&pts).unwrap();
-        assert_eq!((t.num_vertices(), t.num_triangles(), ids.len()), (n as usize, 0, n as usize));
+        assert_eq!(
+            (t.num_vertices(), t.num_triangles(), ids.len()),
+            (n as usize, 0, n as usize)
+        );
         assert!(t.hull().is_empty());
         assert_eq!(t.locate(Point::new(0.0, 0.0)), Location::NoTriangles);
         t.check().unwrap();
@@ -112,7 +138,8 @@ fn empty_one_and_two_points() {
 fn collinear_points_wait_for_a_point_off_their_line() {
     let mut t = Triangulation::new();
     for i in 0..50 {
-        t.insert(Point::new(f64::from(i), 2.0 * f64::from(i))).unwrap();
+        t.insert(Point::new(f64::from(i), 2.0 * f64::from(i)))
+            .unwrap();
     }
     assert!(t.is_degenerate());
     assert_eq!(t.insert(Point::new(7.0, 14.0)).unwrap(), VertexId::new(7));
@@ -137,7 +164,10 @@ fn duplicates_map_to_the_first_vertex_in_input_order() {
     ];
     let (t, ids) = Triangulation::from_points(&pts).unwrap();
     assert_eq!(t.num_vertices(), 4);
-    assert_eq!(ids.iter().map(|v| v.index()).collect::<Vec<_>>(), [0, 1, 0, 2, 1, 3]);
+    assert_eq!(
+        ids.iter().map(|v| v.index()).collect::<Vec<_>>(),
+        [0, 1, 0, 2, 1, 3]
+    );
     t.check().unwrap();
 }
 
@@ -168,7 +198,10 @@ fn incremental_insertion_reports_exactly_the_new_star() {
         let created = t.created_triangles();
         // The new star: every created triangle has the new vertex, and every triangle with the new
         // vertex was created.
-        let star: Vec<TriangleId> = t.triangles().filter(|&f| t.triangle_vertices(f).contains(&v)).collect();
+        let star: Vec<TriangleId> = t
+            .triangles()
+            .filter(|&f| t.triangle_vertices(f).contains(&v))
+            .collect();
         let mut c = created.to_vec();
         c.sort();
         assert_eq!(c, star);
@@ -191,7 +224,10 @@ fn locate_classifies_every_kind_of_position() {
         }
         other => panic!("expected an edge, got {other:?}"),
     }
-    assert!(matches!(t.locate(Point::new(1.2, 2.1)), Location::InTriangle(_)));
+    assert!(matches!(
+        t.locate(Point::new(1.2, 2.1)),
+        Location::InTriangle(_)
+    ));
     match t.locate(Point::new(10.0, 1.0)) {
         Location::OutsideHull(e) => {
             let (a, b) = (t.point(t.origin(e)), t.point(t.destination(e)));
@@ -205,7 +241,10 @@ fn locate_classifies_every_kind_of_position() {
 #[test]
 fn non_finite_points_are_refused_with_their_index() {
     let pts = [Point::new(0.0, 0.0), Point::new(f64::NAN, 1.0)];
-    assert!(matches!(Triangulation::from_points(&pts), Err(GeomError::NonFinitePoint { index: 1, .. })));
+    assert!(matches!(
+        Triangulation::from_points(&pts),
+        Err(GeomError::NonFinitePoint { index: 1, .. })
+    ));
     let mut t = Triangulation::new();
     assert!(t.insert(Point::new(0.0, f64::INFINITY)).is_err());
     assert_eq!(t.num_vertices(), 0);
@@ -213,14 +252,21 @@ fn non_finite_points_are_refused_with_their_index() {
 
 #[test]
 fn edges_and_hull_are_consistent_with_euler() {
-    let pts: Vec<Point> = (0..300u32).map(|i| Point::new(f64::from(i % 17) * 1.3, f64::from(i * 31 % 23))).collect();
+    let pts: Vec<Point> = (0..300u32)
+        .map(|i| Point::new(f64::from(i % 17) * 1.3, f64::from(i * 31 % 23)))
+        .collect();
     let (t, _) = Triangulation::from_points(&pts).unwrap();
     let edges = t.edges().count();
     // E = 3F/2 + h/2 for a triangulated disk.
     assert_eq!(2 * edges, 3 * t.num_triangles() + t.hull().len());
     let hull = t.hull();
     for i in 0..hull.len() {
-        let [a, b, c] = [hull[i], hull[(i + 1) % hull.len()], hull[(i + 2) % hull.len()]].map(|v| t.point(v));
+        let [a, b, c] = [
+            hull[i],
+            hull[(i + 1) % hull.len()],
+            hull[(i + 2) % hull.len()],
+        ]
+        .map(|v| t.point(v));
         assert!(orient2d(a, b, c) >= 0.0);
     }
 }
@@ -234,20 +280,36 @@ fn a_larger_random_set_and_a_sparse_grid() {
         s ^= s << 17;
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    let pts: Vec<Point> = (0..20_000).map(|_| Point::new(rnd() * 1000.0, rnd() * 1000.0)).collect();
+    let pts: Vec<Point> = (0..20_000)
+        .map(|_| Point::new(rnd() * 1000.0, rnd() * 1000.0))
+        .collect();
     assert_delaunay_of(&pts);
-    let sparse: Vec<Point> = grid(300, 200).into_iter().enumerate().filter(|(i, _)| i % 3 != 1).map(|(_, p)| p).collect();
+    let sparse: Vec<Point> = grid(300, 200)
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| i % 3 != 1)
+        .map(|(_, p)| p)
+        .collect();
     assert_delaunay_of(&sparse);
 }
 
 fn small_int_points() -> impl Strategy<Value = Vec<Point>> {
-    prop::collection::vec((0i32..12, 0i32..12), 0..60)
-        .prop_map(|v| v.into_iter().map(|(x, y)| Point::new(f64::from(x), f64::from(y))).collect())
+    prop::collection::vec((0i32..12, 0i32..12), 0..60).prop_map(|v| {
+        v.into_iter()
+            .map(|(x, y)| Point::new(f64::from(x), f64::from(y)))
+            .collect()
+    })
 }
 
 fn collinear_runs() -> impl Strategy<Value = Vec<Point>> {
     // Runs of points along random integer directions, plus a few strays: long collinear hull sides.
-    (prop::collection::vec((-20i32..20, -20i32..20, -3i32..4, -3i32..4, 1usize..15), 1..5), prop::collection::vec((-30.0f64..30.0, -30.0f64..30.0), 0..6))
+    (
+        prop::collection::vec(
+            (-20i32..20, -20i32..20, -3i32..4, -3i32..4, 1usize..15),
+            1..5,
+        ),
+        prop::collection::vec((-30.0f64..30.0, -30.0f64..30.0), 0..6),
+    )
         .prop_map(|(runs, strays)| {
             let mut pts = Vec::new();
             for (x, y, dx, dy, n) in runs {
@@ -261,9 +323,18 @@ fn collinear_runs() -> impl Strategy<Value = Vec<Point>> {
 }
 
 fn grid_subsets() -> impl Strategy<Value = Vec<Point>> {
-    (1u32..25, 1u32..25, prop::collection::vec(any::<bool>(), 625))
+    (
+        1u32..25,
+        1u32..25,
+        prop::collection::vec(any::<bool>(), 625),
+    )
         .prop_map(|(w, h, keep)| {
-            grid(w, h).into_iter().enumerate().filter(|(i, _)| keep[*i]).map(|(_, p)| p).collect()
+            grid(w, h)
+                .into_iter()
+                .enumerate()
+                .filter(|(i, _)| keep[*i])
+                .map(|(_, p)| p)
+                .collect()
         })
 }
 

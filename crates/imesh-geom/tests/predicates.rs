@@ -16,7 +16,11 @@ fn robust_incircle(a: Point, b: Point, c: Point, d: Point) -> f64 {
 
 fn lattice_point() -> impl Strategy<Value = Point> {
     // Multiples of 1/4 (pixel centres, corners, edge midpoints and their midpoints), some far out.
-    (-40i64..40, -40i64..40, prop::sample::select(vec![1.0, 1.0, 1.0, 1e6, 3e9]))
+    (
+        -40i64..40,
+        -40i64..40,
+        prop::sample::select(vec![1.0, 1.0, 1.0, 1e6, 3e9]),
+    )
         .prop_map(|(x, y, s)| Point::new(x as f64 * 0.25 * s, y as f64 * 0.25 * s))
 }
 
@@ -25,8 +29,10 @@ fn any_point() -> impl Strategy<Value = Point> {
         lattice_point(),
         (-10.0f64..10.0, -10.0f64..10.0).prop_map(|(x, y)| Point::new(x, y)),
         // Tiny perturbations of lattice points: the hardest case for the filter.
-        (lattice_point(), -3i32..4, -3i32..4)
-            .prop_map(|(p, i, j)| Point::new(p.x + f64::from(i) * 1e-15, p.y + f64::from(j) * 1e-13)),
+        (lattice_point(), -3i32..4, -3i32..4).prop_map(|(p, i, j)| Point::new(
+            p.x + f64::from(i) * 1e-15,
+            p.y + f64::from(j) * 1e-13
+        )),
     ]
 }
 

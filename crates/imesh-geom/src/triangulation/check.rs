@@ -105,7 +105,10 @@ impl Triangulation {
             let [a, bb, c] = v.map(|x| self.points[x as usize]);
             let orient = orient2d(a, bb, c);
             if orient <= 0.0 {
-                return Err(TriangulationDefect::NotCounterClockwise { triangle: t, orient });
+                return Err(TriangulationDefect::NotCounterClockwise {
+                    triangle: t,
+                    orient,
+                });
             }
         }
         if ghosts != self.ghost_count {
@@ -132,7 +135,11 @@ impl Triangulation {
         }
         if let [a, b, ..] = self.pending[..] {
             let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
-            if let Some(&v) = self.pending.iter().find(|&&v| orient2d(pa, pb, self.points[v as usize]) != 0.0) {
+            if let Some(&v) = self
+                .pending
+                .iter()
+                .find(|&&v| orient2d(pa, pb, self.points[v as usize]) != 0.0)
+            {
                 return Err(TriangulationDefect::HullNotConvex { vertex: v });
             }
         }
@@ -194,7 +201,9 @@ impl Triangulation {
         for i in 0..h {
             let [a, b, c] = [hull[i], hull[(i + 1) % h], hull[(i + 2) % h]].map(|v| self.point(v));
             if orient2d(a, b, c) < 0.0 {
-                return Err(TriangulationDefect::HullNotConvex { vertex: hull[(i + 1) % h].0 });
+                return Err(TriangulationDefect::HullNotConvex {
+                    vertex: hull[(i + 1) % h].0,
+                });
             }
             let (u, w) = (b - a, c - b);
             turning += (u.x * w.y - u.y * w.x).atan2(u.x * w.x + u.y * w.y);
@@ -233,7 +242,10 @@ mod tests {
         let d = t.origin[next(next(o)) as usize];
         let (te, to) = (3 * (e / 3), 3 * (o / 3));
         let (ea, eb) = (t.twin[next(o) as usize], t.twin[next(e) as usize]);
-        let (ec, ed) = (t.twin[next(next(e)) as usize], t.twin[next(next(o)) as usize]);
+        let (ec, ed) = (
+            t.twin[next(next(e)) as usize],
+            t.twin[next(next(o)) as usize],
+        );
         // New triangles (c, d, b) and (d, c, a).
         t.origin[te as usize..te as usize + 3].copy_from_slice(&[c, d, b]);
         t.origin[to as usize..to as usize + 3].copy_from_slice(&[d, c, a]);
@@ -260,7 +272,10 @@ mod tests {
             .find(|&e| {
                 let o = t.twin[e as usize];
                 !t.is_ghost_slot(e / 3) && !t.is_ghost_slot(o / 3) && {
-                    let (c, d) = (t.origin[next(next(e)) as usize], t.origin[next(next(o)) as usize]);
+                    let (c, d) = (
+                        t.origin[next(next(e)) as usize],
+                        t.origin[next(next(o)) as usize],
+                    );
                     let (a, b) = (t.origin[e as usize], t.origin[o as usize]);
                     let p = |v: u32| t.points[v as usize];
                     // A flip is geometrically valid when c and d lie on opposite sides of a-b's
@@ -270,29 +285,47 @@ mod tests {
             })
             .expect("some convex quadrilateral");
         flip(&mut t, e);
-        assert!(matches!(t.check(), Err(TriangulationDefect::NotDelaunay { .. })), "{:?}", t.check());
+        assert!(
+            matches!(t.check(), Err(TriangulationDefect::NotDelaunay { .. })),
+            "{:?}",
+            t.check()
+        );
     }
 
     #[test]
     fn reversed_triangle_is_reported() {
         let mut t = square_with_centre();
-        let f = (0..t.origin.len() as u32 / 3).find(|&f| !t.is_ghost_slot(f)).unwrap() as usize;
+        let f = (0..t.origin.len() as u32 / 3)
+            .find(|&f| !t.is_ghost_slot(f))
+            .unwrap() as usize;
         t.origin.swap(3 * f, 3 * f + 1);
-        assert!(matches!(t.check(), Err(TriangulationDefect::NotCounterClockwise { .. })));
+        assert!(matches!(
+            t.check(),
+            Err(TriangulationDefect::NotCounterClockwise { .. })
+        ));
     }
 
     #[test]
     fn broken_twin_and_vertex_links_are_reported() {
         let mut t = square_with_centre();
         t.twin[0] = t.twin[1];
-        assert!(matches!(t.check(), Err(TriangulationDefect::BadTwin { .. })));
+        assert!(matches!(
+            t.check(),
+            Err(TriangulationDefect::BadTwin { .. })
+        ));
         let mut t = square_with_centre();
         let e = t.out_edge[4];
         t.out_edge[4] = next(e);
-        assert!(matches!(t.check(), Err(TriangulationDefect::BadVertexEdge { vertex: 4 })));
+        assert!(matches!(
+            t.check(),
+            Err(TriangulationDefect::BadVertexEdge { vertex: 4 })
+        ));
         let mut t = square_with_centre();
         t.ghost_count += 1;
-        assert!(matches!(t.check(), Err(TriangulationDefect::GhostCount { .. })));
+        assert!(matches!(
+            t.check(),
+            Err(TriangulationDefect::GhostCount { .. })
+        ));
     }
 
     #[test]

@@ -157,7 +157,9 @@ impl Triangulation {
             return Location::NoTriangles;
         }
         match self.walk(p) {
-            Walk::Outside(g) => Location::OutsideHull(HalfEdgeId(self.twin[self.ghost_real_edge(g) as usize])),
+            Walk::Outside(g) => {
+                Location::OutsideHull(HalfEdgeId(self.twin[self.ghost_real_edge(g) as usize]))
+            }
             Walk::Inside(t) => {
                 for e in 3 * t..3 * t + 3 {
                     let a = self.origin[e as usize];
@@ -378,7 +380,11 @@ impl Triangulation {
     /// After a bulk build in which vertex `rank` is input point `order[rank]`: drops the vertices
     /// that duplicated another (pairs `(duplicate, kept)`, as ranks) and renumbers the rest densely
     /// in input order. Returns the vertex of every input point.
-    fn renumber_to_input_order(&mut self, order: &[u32], duplicates: &[(u32, u32)]) -> Vec<VertexId> {
+    fn renumber_to_input_order(
+        &mut self,
+        order: &[u32],
+        duplicates: &[(u32, u32)],
+    ) -> Vec<VertexId> {
         let n = order.len();
         let mut dropped = vec![false; n]; // by input index
         for &(rank, _) in duplicates {

@@ -304,7 +304,11 @@ impl Triangulation {
 
     /// The half-edges of triangle `t`: the `i`-th leaves its `i`-th vertex.
     pub fn triangle_edges(&self, t: TriangleId) -> [HalfEdgeId; 3] {
-        [HalfEdgeId(3 * t.0), HalfEdgeId(3 * t.0 + 1), HalfEdgeId(3 * t.0 + 2)]
+        [
+            HalfEdgeId(3 * t.0),
+            HalfEdgeId(3 * t.0 + 1),
+            HalfEdgeId(3 * t.0 + 2),
+        ]
     }
 
     /// The real triangle on the other side of half-edge `e`, or `None` across the hull.
