@@ -2,19 +2,25 @@
 //!
 //! ```text
 //! cargo xtask bench delaunay [--runs N] [--quick]
+//! cargo xtask fixtures quality
 //! ```
 
 mod alloc;
 mod bench_delaunay;
+mod fixtures;
 
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
+       cargo xtask fixtures quality
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
                    writes target/bench/delaunay.json
     --runs N       timed runs per input and implementation (median reported; default 7)
-    --quick        smaller inputs (10^4, 10^5 points, 316x316 grid) for a fast check";
+    --quick        smaller inputs (10^4, 10^5 points, 316x316 grid) for a fast check
+
+  fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
+                   vtkMeshQuality, installed from PyPI into target/venv-vtk";
 
 #[global_allocator]
 static ALLOCATOR: alloc::CountingAllocator = alloc::CountingAllocator;
@@ -51,6 +57,7 @@ fn run(args: &[String]) -> Result<(), String> {
             }
             bench_delaunay::run(&options)
         }
+        ["fixtures", "quality"] => fixtures::quality(),
         [] | ["help"] | ["--help"] | ["-h"] => {
             println!("{USAGE}");
             Ok(())
