@@ -1,0 +1,139 @@
+//! Clean-up of a label grid: small regions and isolated pixels.
+
+use std::collections::HashMap;
+
+use image::{ImageBuffer, Luma};
+use imageproc::region_labelling::{connected_components, Connectivity};
+use rayon::prelude::*;
+
+use crate::LabelGrid;
+
+/// Merges every 4-connected region smaller than `min_pixels` into the neighbouring region it shares
+/// the longest border with (smallest regions first, so that a merged region grows before its own
+/// turn comes). A region with no neighbour (the whole image) is kept.
+///
+/// ```
+/// use imesh_classify::{remove_small_regions, LabelGrid, Region};
+/// let r = |n: &str| Region { name: n.into(), colour: [0, 0, 0] };
+/// // A single pixel of label 1 inside label 0.
+/// let g = LabelGrid::new(3, 3, vec![0, 0, 0, 0, 1, 0, 0, 0, 0], vec![r("a"), r("b")]).unwrap();
+/// let clean = remove_small_regions(&g, 2);
+/// assert!(clean.labels().iter().all(|&l| l == 0));
+/// assert_eq!(clean.num_labels(), 1);
+/// ```
+pub fn remove_small_regions(grid: &LabelGrid, min_pixels: usize) -> LabelGrid {
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let img: ImageBuffer<Luma<u32>, Vec<u32>> =
+        ImageBuffer::from_raw(grid.width(), grid.height(), grid.labels().to_vec())
+            .expect("the grid has W×H labels");
+    // No label equals u32::MAX, so every pixel belongs to some component (ids from 1).
+    let comp = connected_components(&img, Connectivity::Four, Luma([u32::MAX])).into_raw();
+    let n = comp.iter().copied().max().unwrap_or(0) as usize + 1;
+    let mut size = vec![0usize; n];
+    let mut label = vec![0u32; n];
+    let mut border: Vec<HashMap<u32, usize>> = vec![HashMap::new(); n];
+    for (i, &c) in comp.iter().enumerate() {
+        size[c as usize] += 1;
+        label[c as usize] = grid.labels()[i];
+        let (x, y) = (i % w, i / w);
+        for j in [(x + 1 < w).then(|| i + 1), (y + 1 < h).then(|| i + w)]
+            .into_iter()
+            .flatten()
+        {
+            let d = comp[j];
+            if d != c {
+                *border[c as usize].entry(d).or_default() += 1;
+                *border[d as usize].entry(c).or_default() += 1;
+            }
+        }
+    }
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut c: u32) -> u32 {
+        while parent[c as usize] != c {
+            parent[c as usize] = parent[parent[c as usize] as usize];
+            c = parent[c as usize];
+        }
+        c
+    }
+    let mut small: Vec<u32> = (1..n as u32)
+        .filter(|&c| size[c as usize] < min_pixels)
+        .collect();
+    small.sort_by_key(|&c| (size[c as usize], c));
+    for c in small {
+        if find(&mut parent, c) != c || size[c as usize] >= min_pixels {
+            continue;
+        }
+        // Borders to current roots (earlier merges may have joined some neighbours).
+        let mut by_root: HashMap<u32, usize> = HashMap::new();
+        for (&d, &len) in &border[c as usize] {
+            let r = find(&mut parent, d);
+            if r != c {
+                *by_root.entry(r).or_default() += len;
+            }
+        }
+        let Some((&target, _)) = by_root
+            .iter()
+            .max_by_key(|(&r, &len)| (len, std::cmp::Reverse((label[r as usize], r))))
+        else {
+            continue;
+        };
+        parent[c as usize] = target;
+        size[target as usize] += size[c as usize];
+        let moved = std::mem::take(&mut border[c as usize]);
+        for (d, len) in moved {
+            *border[target as usize].entry(d).or_default() += len;
+        }
+    }
+    let root_label: Vec<u32> = (0..n as u32)
+        .map(|c| label[find(&mut parent, c) as usize])
+        .collect();
+    grid.with_labels(comp.iter().map(|&c| root_label[c as usize]).collect())
+}
+
+/// Replaces each label by the most frequent label in its `(2r+1)²` window (ties keep the pixel's
+/// own label), `iterations` times: removes speckle from pixel classifiers.
+///
+/// ```
+/// use imesh_classify::{majority_filter, LabelGrid, Region};
+/// let r = |n: &str| Region { name: n.into(), colour: [0, 0, 0] };
+/// let g = LabelGrid::new(3, 3, vec![0, 0, 0, 0, 1, 0, 0, 0, 0], vec![r("a"), r("b")]).unwrap();
+/// assert_eq!(majority_filter(&g, 1, 1).label(1, 1), 0);
+/// ```
+pub fn majority_filter(grid: &LabelGrid, radius: u32, iterations: u32) -> LabelGrid {
+    let (w, h) = (grid.width() as i64, grid.height() as i64);
+    let r = i64::from(radius);
+    let mut labels = grid.labels().to_vec();
+    for _ in 0..iterations {
+        let src = &labels;
+        let next: Vec<u32> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                // (label, count) pairs: a window holds at most (2r+1)² labels, so a linear tally
+                // beats hashing.
+                let mut tally: Vec<(u32, u32)> = Vec::new();
+                (0..w).map(move |x| {
+                    tally.clear();
+                    for yy in (y - r).max(0)..=(y + r).min(h - 1) {
+                        for xx in (x - r).max(0)..=(x + r).min(w - 1) {
+                            let l = src[(yy * w + xx) as usize];
+                            match tally.iter_mut().find(|(t, _)| *t == l) {
+                                Some((_, c)) => *c += 1,
+                                None => tally.push((l, 1)),
+                            }
+                        }
+                    }
+                    let own = src[(y * w + x) as usize];
+                    let own_count = tally.iter().find(|(t, _)| *t == own).map_or(0, |&(_, c)| c);
+                    // Only a strictly larger count replaces the pixel's own label.
+                    tally
+                        .iter()
+                        .filter(|&&(_, c)| c > own_count)
+                        .max_by_key(|&&(l, c)| (c, std::cmp::Reverse(l)))
+                        .map_or(own, |&(l, _)| l)
+                })
+            })
+            .collect();
+        labels = next;
+    }
+    grid.with_labels(labels)
+}

@@ -1,0 +1,367 @@
+//! Classifiers on real fixture images, and bad input.
+
+use std::path::{Path, PathBuf};
+
+use image::{DynamicImage, GenericImageView, ImageBuffer, Luma, LumaA, Rgb, RgbImage};
+use imesh_classify::{
+    classify, kmeans, label_map, load_image, looks_like_label_map, majority_filter,
+    multi_otsu_levels, remove_small_regions, Classifier, ClassifyError, ClassifyOptions, LabelGrid,
+    Region, TextureClassifier, TextureSamples, DEFAULT_MAX_PIXELS,
+};
+
+fn fixture_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name)
+}
+
+fn fixture(name: &str) -> DynamicImage {
+    load_image(&fixture_path(name), DEFAULT_MAX_PIXELS).unwrap()
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("imesh-classify-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn otsu_matches_imageproc_on_grey_fixtures() {
+    for name in [
+        "skimage-camera.png",
+        "skimage-coins.png",
+        "matplotlib-s1045_mri.png",
+    ] {
+        let grey = fixture(name).to_luma8();
+        let reference = imageproc::contrast::otsu_level(&grey);
+        // Our multi-level dynamic programme with two classes must find the same level.
+        assert_eq!(multi_otsu_levels(&grey, 2), vec![reference], "{name}");
+        let grid = classify(
+            &fixture(name),
+            &Classifier::Otsu { classes: 2 },
+            &ClassifyOptions::default(),
+        )
+        .unwrap();
+        for (i, &v) in grey.as_raw().iter().enumerate() {
+            assert_eq!(grid.labels()[i], u32::from(v > reference));
+        }
+    }
+}
+
+#[test]
+fn multi_otsu_splits_the_mri_into_ordered_classes() {
+    let img = fixture("matplotlib-s1045_mri.png");
+    let grey = img.to_luma8();
+    let levels = multi_otsu_levels(&grey, 4);
+    assert_eq!(levels.len(), 3);
+    assert!(levels.windows(2).all(|w| w[0] < w[1]), "{levels:?}");
+    let grid = classify(
+        &img,
+        &"otsu:4".parse().unwrap(),
+        &ClassifyOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(grid.num_labels(), 4);
+    // Brighter pixels never get a lower class.
+    let mut class_max = [0u8; 4];
+    for (i, &v) in grey.as_raw().iter().enumerate() {
+        let c = grid.labels()[i] as usize;
+        class_max[c] = class_max[c].max(v);
+    }
+    assert!(class_max.windows(2).all(|w| w[0] < w[1]));
+}
+
+#[test]
+fn explicit_thresholds() {
+    let img = fixture("skimage-camera.png");
+    let grid = classify(
+        &img,
+        &"threshold:80,170".parse().unwrap(),
+        &ClassifyOptions::default(),
+    )
+    .unwrap();
+    let grey = img.to_luma8();
+    for (i, &v) in grey.as_raw().iter().enumerate().step_by(97) {
+        let expected = if v <= 80 {
+            0
+        } else if v <= 170 {
+            1
+        } else {
+            2
+        };
+        assert_eq!(grid.labels()[i], expected);
+    }
+    assert_eq!(grid.regions()[1].name, "luminance 81–170");
+}
+
+#[test]
+fn kmeans_is_deterministic_and_blind_to_pixel_order() {
+    let img = fixture("skimage-coffee.png");
+    let a = kmeans(&img, 4);
+    let b = kmeans(&img, 4);
+    assert_eq!(a, b);
+    assert_eq!(a.num_labels(), 4);
+    // Clusters are ordered by lightness: the mean colours' luminance increases.
+    let lum =
+        |c: [u8; 3]| 0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2]);
+    let l: Vec<f64> = a.regions().iter().map(|r| lum(r.colour)).collect();
+    assert!(l.windows(2).all(|w| w[0] <= w[1] + 20.0), "{l:?}");
+    // Permute the pixels (a fixed pseudo-random bijection): every pixel keeps its label.
+    let (w, h) = img.dimensions();
+    let n = (w * h) as u64;
+    let perm = |i: u64| (i * 7_919 + 13) % n; // 7919 is prime and does not divide 240000
+    let rgb = img.to_rgb8();
+    let mut shuffled = RgbImage::new(w, h);
+    for i in 0..n {
+        let j = perm(i);
+        shuffled.put_pixel(
+            (j % u64::from(w)) as u32,
+            (j / u64::from(w)) as u32,
+            *rgb.get_pixel((i % u64::from(w)) as u32, (i / u64::from(w)) as u32),
+        );
+    }
+    let c = kmeans(&DynamicImage::ImageRgb8(shuffled), 4);
+    for i in 0..n {
+        assert_eq!(c.labels()[perm(i) as usize], a.labels()[i as usize]);
+    }
+}
+
+#[test]
+fn label_maps_round_trip_through_a_colour_png() {
+    for (name, expected) in [
+        ("pyvista-channels_z050_labels.png", 5),
+        ("stardist-mask2d_labels.png", 126),
+    ] {
+        let img = fixture(name);
+        assert!(looks_like_label_map(&img, 256), "{name}");
+        let grid = label_map(&img, 256).unwrap();
+        assert_eq!(grid.num_labels(), expected, "{name}");
+        assert_eq!(grid.regions()[0].name, "value 0");
+        // Auto picks the label map.
+        assert_eq!(
+            classify(&img, &Classifier::Auto, &ClassifyOptions::default()).unwrap(),
+            grid
+        );
+        // Labels are the grey values' order: pixel value v has label rank(v).
+        let grey = img.to_luma8();
+        let mut values: Vec<u8> = grey.as_raw().clone();
+        values.sort_unstable();
+        values.dedup();
+        for (i, &v) in grey.as_raw().iter().enumerate().step_by(13) {
+            assert_eq!(grid.labels()[i] as usize, values.binary_search(&v).unwrap());
+        }
+        // Written as colours and read back, the partition is the same (colours are distinct).
+        if expected <= 12 {
+            let path = temp_dir("roundtrip").join(format!("{name}.png"));
+            grid.save_png(&path).unwrap();
+            let back = label_map(&load_image(&path, DEFAULT_MAX_PIXELS).unwrap(), 256).unwrap();
+            assert_eq!(back.num_labels(), grid.num_labels());
+            let mut map = vec![u32::MAX; grid.num_labels()];
+            for (a, b) in grid.labels().iter().zip(back.labels()) {
+                let m = &mut map[*a as usize];
+                assert!(*m == u32::MAX || *m == *b, "a label split in two");
+                *m = *b;
+            }
+        }
+    }
+}
+
+#[test]
+fn auto_thresholds_a_photograph() {
+    let img = fixture("skimage-camera.png");
+    assert!(!looks_like_label_map(&img, 256));
+    let grid = classify(&img, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
+    assert_eq!(grid.num_labels(), 2);
+}
+
+#[test]
+fn deep_and_alpha_images_load_and_label() {
+    let dir = temp_dir("deep");
+    let deep: ImageBuffer<Luma<u16>, Vec<u16>> =
+        ImageBuffer::from_fn(20, 10, |x, _| Luma([if x < 10 { 1000 } else { 60000 }]));
+    let p16 = dir.join("deep.png");
+    deep.save(&p16).unwrap();
+    let grid = label_map(&load_image(&p16, DEFAULT_MAX_PIXELS).unwrap(), 256).unwrap();
+    assert_eq!(grid.num_labels(), 2);
+    assert_eq!(grid.regions()[1].name, "value 60000");
+    let alpha: ImageBuffer<LumaA<u8>, Vec<u8>> =
+        ImageBuffer::from_fn(8, 8, |x, y| LumaA([if x + y < 8 { 0 } else { 255 }, 255]));
+    let pa = dir.join("alpha.png");
+    alpha.save(&pa).unwrap();
+    assert_eq!(
+        label_map(&load_image(&pa, DEFAULT_MAX_PIXELS).unwrap(), 256)
+            .unwrap()
+            .num_labels(),
+        2
+    );
+}
+
+#[test]
+fn noise_has_too_many_values_for_a_label_map() {
+    let img = DynamicImage::ImageRgb8(RgbImage::from_fn(64, 64, |x, y| {
+        Rgb([x as u8 * 4, y as u8 * 4, (x * y) as u8])
+    }));
+    let err = label_map(&img, 256).unwrap_err();
+    assert!(matches!(err, ClassifyError::TooManyLabels { limit: 256 }));
+    assert!(
+        err.to_string().contains("kmeans"),
+        "the message gives advice: {err}"
+    );
+    assert_eq!(label_map(&img, 5000).unwrap().num_labels(), 4096);
+}
+
+#[test]
+fn bad_files_are_clear_errors() {
+    let dir = temp_dir("bad");
+    let missing = load_image(&dir.join("nope.png"), DEFAULT_MAX_PIXELS).unwrap_err();
+    assert!(matches!(missing, ClassifyError::Io { .. }), "{missing}");
+    // A truncated PNG: the first half of a real one.
+    let bytes = std::fs::read(fixture_path("pyvista-channels_z050_labels.png")).unwrap();
+    let cut = dir.join("truncated.png");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let e = load_image(&cut, DEFAULT_MAX_PIXELS).unwrap_err();
+    assert!(matches!(e, ClassifyError::Decode { .. }), "{e}");
+    // Not an image at all.
+    let text = dir.join("text.png");
+    std::fs::write(&text, "hello").unwrap();
+    assert!(matches!(
+        load_image(&text, DEFAULT_MAX_PIXELS).unwrap_err(),
+        ClassifyError::Decode { .. }
+    ));
+    // An empty 0 × 0 image (a PNM header).
+    let empty = dir.join("empty.pgm");
+    std::fs::write(&empty, "P5\n0 0\n255\n").unwrap();
+    let e = load_image(&empty, DEFAULT_MAX_PIXELS).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ClassifyError::EmptyImage { .. } | ClassifyError::Decode { .. }
+        ),
+        "{e}"
+    );
+    // Over the pixel limit: refused before decoding.
+    let e = load_image(&fixture_path("skimage-camera.png"), 1000).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ClassifyError::TooLarge {
+                width: 512,
+                height: 512,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_specs_are_clear_errors() {
+    for spec in [
+        "",
+        "otsu:1",
+        "otsu:x",
+        "threshold:",
+        "threshold:200,100",
+        "threshold:300",
+        "kmeans",
+        "kmeans:100",
+        "texture:",
+        "sobel",
+    ] {
+        let e = spec.parse::<Classifier>().unwrap_err();
+        assert!(matches!(e, ClassifyError::BadSpec { .. }), "{spec}: {e}");
+    }
+}
+
+#[test]
+fn bad_sample_files_are_clear_errors() {
+    let p: &Path = "samples.toml".as_ref();
+    let single = "[[label]]\nname = \"a\"\nrectangles = [[0, 0, 4, 4]]\n";
+    let e = TextureSamples::parse(single, p).unwrap_err();
+    assert!(e.to_string().contains("at least two labels"), "{e}");
+    let malformed = "[[label]]\nname = \"a\"\nrectangles = [[0, 0, 4]]\n[[label]]\nname = \"b\"\nrectangles = [[0, 0, 4, 4]]\n";
+    let e = TextureSamples::parse(malformed, p).unwrap_err();
+    assert!(matches!(e, ClassifyError::Samples { .. }), "{e}");
+    assert!(
+        e.to_string().contains("line 3"),
+        "the error names the line: {e}"
+    );
+    let garbage = "window = = 3";
+    assert!(TextureSamples::parse(garbage, p).is_err());
+    let unknown = "windw = 3\n";
+    assert!(TextureSamples::parse(unknown, p)
+        .unwrap_err()
+        .to_string()
+        .contains("windw"));
+    let even = "window = 4\n[[label]]\nname = \"a\"\nrectangles = [[0, 0, 4, 4]]\n[[label]]\nname = \"b\"\nrectangles = [[4, 0, 4, 4]]\n";
+    assert!(TextureSamples::parse(even, p)
+        .unwrap_err()
+        .to_string()
+        .contains("odd"));
+    // A rectangle outside the image.
+    let ok = "[[label]]\nname = \"a\"\nrectangles = [[0, 0, 4, 4]]\n[[label]]\nname = \"b\"\nrectangles = [[10, 0, 8, 4]]\n";
+    let samples = TextureSamples::parse(ok, p).unwrap();
+    let img = DynamicImage::ImageLuma8(image::GrayImage::new(16, 16));
+    let e = TextureClassifier::train(&img, &samples).err().unwrap();
+    assert!(
+        matches!(
+            e,
+            ClassifyError::RectangleOutside {
+                rect: [10, 0, 8, 4],
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // A missing sample file through the spec.
+    let e = classify(
+        &img,
+        &"texture:/nonexistent/s.toml".parse().unwrap(),
+        &ClassifyOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, ClassifyError::Io { .. }));
+}
+
+fn grid_of(w: u32, rows: &[&str]) -> LabelGrid {
+    let labels: Vec<u32> = rows
+        .iter()
+        .flat_map(|r| r.bytes().map(|b| u32::from(b - b'0')))
+        .collect();
+    let n = labels.iter().max().map_or(0, |&m| m + 1);
+    let regions = (0..n)
+        .map(|i| Region {
+            name: format!("r{i}"),
+            colour: [0, 0, 0],
+        })
+        .collect();
+    LabelGrid::new(w, rows.len() as u32, labels, regions).unwrap()
+}
+
+#[test]
+fn small_regions_merge_into_their_longest_border_neighbour() {
+    let g = grid_of(6, &["000111", "020111", "000111", "000131", "000111"]);
+    let clean = remove_small_regions(&g, 2);
+    // The single 2 sits inside 0, the single 3 inside 1.
+    let expected = grid_of(6, &["000111", "000111", "000111", "000111", "000111"]);
+    assert_eq!(clean.labels(), expected.labels());
+    assert_eq!(clean.num_labels(), 2);
+    // A region touching two others goes to the one it shares more border with.
+    let g = grid_of(4, &["0011", "0211", "0211", "0011"]);
+    let clean = remove_small_regions(&g, 3);
+    assert_eq!(clean.label(1, 1), clean.label(0, 0));
+    // Nothing smaller than the limit: unchanged. The whole image small: kept.
+    assert_eq!(remove_small_regions(&g, 1), g);
+    let one = grid_of(2, &["00"]);
+    assert_eq!(remove_small_regions(&one, 100), one);
+}
+
+#[test]
+fn majority_filter_removes_speckle_and_keeps_ties() {
+    let g = grid_of(5, &["00000", "00100", "00000", "11111", "11111"]);
+    let f = majority_filter(&g, 1, 1);
+    assert_eq!(f.label(2, 1), 0);
+    // On the straight 0/1 border, each side keeps its label.
+    assert_eq!(f.label(2, 2), 0);
+    assert_eq!(f.label(2, 3), 1);
+}
