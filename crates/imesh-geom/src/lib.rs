@@ -31,11 +31,14 @@ pub mod predicates;
 pub mod spatial_sort;
 
 mod point;
+mod refine;
 mod triangulation;
 
 pub use point::Point;
+pub use refine::{RefineOptions, RefineReport, StopReason};
 pub use triangulation::{
-    HalfEdgeId, Location, TriangleId, Triangulation, TriangulationDefect, VertexId,
+    HalfEdgeId, Location, SegmentId, TriangleId, Triangulation, TriangulationDefect, VertexId,
+    EXTERIOR,
 };
 
 /// Errors of the geometry kernel.
@@ -50,5 +53,31 @@ pub enum GeomError {
         x: f64,
         /// Its y coordinate.
         y: f64,
+    },
+    /// A new segment crosses (or overlaps) an existing one.
+    #[error("segment {new:?} crosses segment {existing_id} {existing:?}: segments may only meet at their ends")]
+    CrossingSegments {
+        /// The new segment's end vertices.
+        new: [u32; 2],
+        /// The existing segment's end vertices.
+        existing: [u32; 2],
+        /// The existing segment's id.
+        existing_id: u32,
+    },
+    /// A refinement angle outside (0°, 34°].
+    #[error("minimum angle {degrees}° is out of range: give an angle above 0° and at most 34° (Ruppert refinement does not terminate above; 33° is a practical maximum)")]
+    BadAngle {
+        /// The angle given.
+        degrees: f64,
+    },
+    /// A segment that cannot be inserted.
+    #[error("cannot insert segment {a}–{b}: {reason}")]
+    BadSegment {
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+        /// Why.
+        reason: &'static str,
     },
 }

@@ -55,6 +55,26 @@ pub enum TriangulationDefect {
     /// V − E + F ≠ 2 on the sphere closed by the ghost vertex.
     #[error("Euler characteristic is {0}, expected 2")]
     Euler(i64),
+    /// The two half-edges of an edge disagree about its segment.
+    #[error("half-edge {edge} and its twin lie on different segments")]
+    SegmentMismatch {
+        /// The half-edge.
+        edge: u32,
+    },
+    /// Two triangles sharing an unconstrained edge have different labels.
+    #[error(
+        "triangles {a} and {b} share an unconstrained edge but have labels {label_a} and {label_b}"
+    )]
+    LabelLeak {
+        /// One triangle.
+        a: u32,
+        /// The other.
+        b: u32,
+        /// Its label.
+        label_a: u32,
+        /// The other's label.
+        label_b: u32,
+    },
     /// The ghost-triangle count disagrees with the stored hull size.
     #[error("{found} ghost triangles but {stored} recorded")]
     GhostCount {
@@ -67,9 +87,10 @@ pub enum TriangulationDefect {
 
 impl Triangulation {
     /// Verifies every invariant with exact predicates: vertex ids, counter-clockwise orientation of
-    /// every triangle, twin symmetry, vertex-to-edge links, the empty-circle property of every edge
-    /// (which, on a triangulation of the convex hull, is the global Delaunay property), convexity of
-    /// the hull and the Euler characteristic.
+    /// every triangle, twin symmetry, vertex-to-edge links, the empty-circle property of every
+    /// unconstrained edge (which, on a triangulation of the convex hull, is the global — constrained —
+    /// Delaunay property), convexity of the hull, the Euler characteristic, and with constraints and
+    /// labels: segment ids agree on both sides of an edge, labels agree across unconstrained edges.
     ///
     /// # Errors
     /// The first [`TriangulationDefect`] found.
@@ -118,6 +139,7 @@ impl Triangulation {
             });
         }
         self.check_twins()?;
+        self.check_constraints()?;
         self.check_vertex_edges()?;
         self.check_empty_circles()?;
         self.check_hull()?;
@@ -161,6 +183,36 @@ impl Triangulation {
         Ok(())
     }
 
+    fn check_constraints(&self) -> Result<(), TriangulationDefect> {
+        if !self.segment.is_empty() {
+            if let Some(e) = (0..self.origin.len())
+                .find(|&e| self.segment[e] != self.segment[self.twin[e] as usize])
+            {
+                return Err(TriangulationDefect::SegmentMismatch { edge: e as u32 });
+            }
+        }
+        if self.label.is_empty() {
+            return Ok(());
+        }
+        for e in 0..self.origin.len() as u32 {
+            let (a, b) = (e / 3, self.twin[e as usize] / 3);
+            let constrained = self.segment.get(e as usize).is_some_and(|&s| s != NONE);
+            if constrained || self.is_ghost_slot(a) || self.is_ghost_slot(b) {
+                continue;
+            }
+            let (label_a, label_b) = (self.label[a as usize], self.label[b as usize]);
+            if label_a != label_b {
+                return Err(TriangulationDefect::LabelLeak {
+                    a,
+                    b,
+                    label_a,
+                    label_b,
+                });
+            }
+        }
+        Ok(())
+    }
+
     fn check_vertex_edges(&self) -> Result<(), TriangulationDefect> {
         for (v, &e) in self.out_edge.iter().enumerate() {
             if e == NONE || e as usize >= self.origin.len() || self.origin[e as usize] != v as u32 {
@@ -173,7 +225,8 @@ impl Triangulation {
     fn check_empty_circles(&self) -> Result<(), TriangulationDefect> {
         for e in 0..self.origin.len() as u32 {
             let t = self.twin[e as usize];
-            if e > t || self.is_ghost_slot(e / 3) || self.is_ghost_slot(t / 3) {
+            let constrained = self.segment.get(e as usize).is_some_and(|&s| s != NONE);
+            if e > t || constrained || self.is_ghost_slot(e / 3) || self.is_ghost_slot(t / 3) {
                 continue;
             }
             let b = 3 * (e / 3) as usize;

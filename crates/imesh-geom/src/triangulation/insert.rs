@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 
-use super::{next, HalfEdgeId, TriangleId, Triangulation, VertexId, GHOST, NONE};
+use super::{next, HalfEdgeId, TriangleId, Triangulation, VertexId, EXTERIOR, GHOST, NONE};
 use crate::predicates::{incircle, orient2d, strictly_between};
 use crate::{GeomError, Point};
 
@@ -38,8 +38,9 @@ pub enum Location {
 pub(crate) struct Scratch {
     stack: Vec<u32>,
     cavity: Vec<u32>,
-    /// Boundary edges of the cavity, counter-clockwise: (origin vertex, outside half-edge).
-    boundary: Vec<(u32, u32)>,
+    /// Boundary edges of the cavity, counter-clockwise: (origin vertex, outside half-edge, the
+    /// cavity half-edge it replaces).
+    boundary: Vec<(u32, u32, u32)>,
     /// Deduplication of the pending (collinear) vertices.
     pending_index: HashMap<(u64, u64), u32>,
 }
@@ -266,13 +267,93 @@ impl Triangulation {
                 t
             }
         };
-        self.dig_cavity(seed, p);
-        self.fill_cavity(v);
+        let split = self.constrained_edge_through(seed, p);
+        self.dig_cavity(seed, p, split);
+        self.fill_cavity(v, split);
         Inserted::New
     }
 
+    /// Inserts `p` as a point of the edge of half-edge `e`, splitting it even when rounding puts the
+    /// computed point a hair off the edge's line (a segment's midpoint or shell point between
+    /// non-lattice ends): the halves keep the edge's segment. Returns the new vertex, or an end of
+    /// the edge when `p` equals it.
+    pub(crate) fn insert_on_edge(&mut self, e: u32, p: Point) -> Result<VertexId, GeomError> {
+        validate(std::slice::from_ref(&p))?;
+        for end in [self.origin[e as usize], self.origin[next(e) as usize]] {
+            if self.points[end as usize] == p {
+                return Ok(VertexId(end));
+            }
+        }
+        // On a hull edge a point a hair inside would make the hull reflex: nudge it out, by the
+        // least multiple of the rounding scale that puts it on or beyond the edge's line.
+        let real = if self.is_ghost_slot(e / 3) {
+            self.twin[e as usize]
+        } else {
+            e
+        };
+        let mut p = p;
+        if self.is_ghost_slot(self.twin[real as usize] / 3) {
+            let (a, b) = (
+                self.points[self.origin[real as usize] as usize],
+                self.points[self.origin[next(real) as usize] as usize],
+            );
+            // The midpoint of lattice ends is exact: prefer it to a rounded shell point.
+            if orient2d(a, b, p) != 0.0 && orient2d(a, b, a.midpoint(b)) == 0.0 {
+                p = a.midpoint(b);
+            }
+            let d = b - a;
+            let outward =
+                Point::new(d.y, -d.x) * (f64::EPSILON / d.x.hypot(d.y).max(f64::MIN_POSITIVE));
+            let scale =
+                a.x.abs()
+                    .max(a.y.abs())
+                    .max(b.x.abs())
+                    .max(b.y.abs())
+                    .max(1.0);
+            let mut k = 1.0;
+            while orient2d(a, b, p) > 0.0 && k < 1e6 {
+                p = p + outward * (k * scale);
+                k *= 2.0;
+            }
+        }
+        let v = self.points.len() as u32;
+        self.points.push(p);
+        self.out_edge.push(NONE);
+        self.created.clear();
+        let seed = real / 3;
+        self.dig_cavity(seed, p, Some(e));
+        self.fill_cavity(v, Some(e));
+        Ok(VertexId(v))
+    }
+
+    /// When `p` lies on the interior of a constrained edge of real triangle `t`: that half-edge.
+    fn constrained_edge_through(&self, t: u32, p: Point) -> Option<u32> {
+        if self.segment.is_empty() || self.is_ghost_slot(t) {
+            return None;
+        }
+        (3 * t..3 * t + 3).find(|&e| {
+            self.segment[e as usize] != NONE && {
+                let a = self.points[self.origin[e as usize] as usize];
+                let b = self.points[self.origin[next(e) as usize] as usize];
+                orient2d(a, b, p) == 0.0
+            }
+        })
+    }
+
     /// Collects the cavity of `p` grown from `seed`, and its boundary in counter-clockwise order.
-    fn dig_cavity(&mut self, seed: u32, p: Point) {
+    ///
+    /// The cavity never crosses a constrained edge (the triangulation stays constrained Delaunay),
+    /// except `split`, the constrained edge `p` lies on, which the insertion splits.
+    fn dig_cavity(&mut self, seed: u32, p: Point, split: Option<u32>) {
+        let blocked = |tri: &Self, e: u32| {
+            let seg = if tri.segment.is_empty() {
+                NONE
+            } else {
+                tri.segment[e as usize]
+            };
+            let lifted = tri.unblock_conforming && seg != NONE && !tri.chains[seg as usize].is_empty();
+            seg != NONE && !lifted && Some(e) != split && Some(tri.twin[e as usize]) != split
+        };
         let mut s = std::mem::take(&mut self.scratch);
         s.cavity.clear();
         s.boundary.clear();
@@ -282,34 +363,65 @@ impl Triangulation {
         while let Some(e) = s.stack.pop() {
             let o = self.twin[e as usize];
             let t = o / 3;
-            if self.in_cavity(t, p) {
+            // Across the edge being split the neighbour always goes: the point is on that edge (at
+            // least up to the rounding of a computed split point).
+            let across_split = split.is_some_and(|h| h == e || self.twin[h as usize] == e);
+            if across_split || (!blocked(self, e) && self.in_cavity(t, p)) {
                 s.cavity.push(t);
                 let n1 = next(o);
                 s.stack.push(next(n1));
                 s.stack.push(n1);
             } else {
-                s.boundary.push((self.origin[e as usize], o));
+                s.boundary.push((self.origin[e as usize], o, e));
             }
         }
         self.scratch = s;
     }
 
-    /// Replaces the cavity by the fan of triangles joining `v` to its boundary.
-    fn fill_cavity(&mut self, v: u32) {
+    /// Replaces the cavity by the fan of triangles joining `v` to its boundary. When `split` is the
+    /// constrained edge `v` lies on, the two spokes to its ends inherit its segment; every new
+    /// triangle inherits the label of the cavity triangle on its side.
+    fn fill_cavity(&mut self, v: u32, split: Option<u32>) {
         let mut s = std::mem::take(&mut self.scratch);
         let m = s.boundary.len();
         debug_assert_eq!(m, s.cavity.len() + 2);
         let ghosts_removed = s.cavity.iter().filter(|&&t| self.is_ghost_slot(t)).count();
+        let constrained = !self.segment.is_empty();
+        let labelled = !self.label.is_empty();
+        // Read everything the rewrite overwrites: labels of the replaced triangles, the split segment.
+        let side_label: Vec<u32> = if labelled {
+            s.boundary
+                .iter()
+                .map(|b| self.label[(b.2 / 3) as usize])
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let split_segment = split.map(|e| {
+            (
+                self.segment[e as usize],
+                self.origin[e as usize],
+                self.origin[next(e) as usize],
+            )
+        });
         for _ in 0..m - s.cavity.len() {
             s.cavity.push((self.origin.len() / 3) as u32);
             self.origin.extend([0; 3]);
             self.twin.extend([0; 3]);
+            if constrained {
+                self.segment.extend([NONE; 3]);
+            }
+            if labelled {
+                self.label.push(EXTERIOR);
+            }
         }
         let mut ghosts_added = 0;
         self.created.clear();
+        // Indexed: triangle i is linked to triangle (i + 1) mod m around the fan.
+        #[allow(clippy::needless_range_loop)]
         for i in 0..m {
             let t = s.cavity[i];
-            let (x, outside) = s.boundary[i];
+            let (x, outside, _) = s.boundary[i];
             let y = s.boundary[(i + 1) % m].0;
             let tn = s.cavity[(i + 1) % m];
             let b = 3 * t as usize;
@@ -324,6 +436,20 @@ impl Triangulation {
             if x != GHOST {
                 self.out_edge[x as usize] = 3 * t;
             }
+            if constrained {
+                self.segment[b] = self.segment[outside as usize];
+                // The spoke v–y (between this triangle and the next) continues a split segment
+                // when y is one of its ends.
+                let spoke = match split_segment {
+                    Some((seg, a, c)) if y == a || y == c => seg,
+                    _ => NONE,
+                };
+                self.segment[b + 1] = spoke;
+                self.segment[3 * tn as usize + 2] = spoke;
+            }
+            if labelled {
+                self.label[t as usize] = side_label[i];
+            }
             if x == GHOST || y == GHOST {
                 ghosts_added += 1;
             } else {
@@ -331,6 +457,16 @@ impl Triangulation {
             }
         }
         self.out_edge[v as usize] = 3 * s.cavity[0] + 2;
+        if let Some((seg, a, c)) = split_segment {
+            // A split conforming segment keeps its vertex chain up to date.
+            let chain = &mut self.chains[seg as usize];
+            if let Some(i) = chain
+                .windows(2)
+                .position(|w| (w[0] == a && w[1] == c) || (w[0] == c && w[1] == a))
+            {
+                chain.insert(i + 1, v);
+            }
+        }
         self.ghost_count = self.ghost_count + ghosts_added - ghosts_removed;
         if let Some(t) = self.created.first() {
             self.hint.store(t.0, Ordering::Relaxed);
@@ -373,6 +509,7 @@ impl Triangulation {
         self.out_edge[a as usize] = 0;
         self.out_edge[b as usize] = 1;
         self.out_edge[c as usize] = 2;
+        debug_assert!(self.segment.is_empty() && self.label.is_empty());
         self.ghost_count = 3;
         self.hint.store(0, Ordering::Relaxed);
     }

@@ -13,6 +13,7 @@
 //! its hull edge plus the open edge itself.
 
 mod check;
+mod constrain;
 mod insert;
 
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -20,6 +21,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use crate::Point;
 
 pub use check::TriangulationDefect;
+pub use constrain::{SegmentId, EXTERIOR};
 pub use insert::Location;
 
 /// The vertex at infinity, third vertex of every ghost triangle.
@@ -31,7 +33,7 @@ macro_rules! handle {
     ($(#[$doc:meta])* $name:ident) => {
         $(#[$doc])*
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-        pub struct $name(u32);
+        pub struct $name(pub(crate) u32);
 
         impl $name {
             /// The handle with this raw index.
@@ -87,6 +89,17 @@ pub struct Triangulation {
     pub(crate) hint: AtomicU32,
     pub(crate) created: Vec<TriangleId>,
     pub(crate) scratch: insert::Scratch,
+    /// Per half-edge: the input segment it lies on, or `NONE`. Empty until the first constraint.
+    pub(crate) segment: Vec<u32>,
+    /// The input segments, as their two end vertices.
+    pub(crate) segments: Vec<[u32; 2]>,
+    /// Per segment: for a conforming segment, its vertices from one end to the other (empty for a
+    /// constrained one).
+    pub(crate) chains: Vec<Vec<u32>>,
+    /// While a conforming segment is being recovered, conforming pieces do not block insertions.
+    pub(crate) unblock_conforming: bool,
+    /// Per triangle slot: its region label. Empty until labels are assigned.
+    pub(crate) label: Vec<u32>,
 }
 
 impl Default for Triangulation {
@@ -107,6 +120,11 @@ impl Clone for Triangulation {
             hint: AtomicU32::new(self.hint.load(Ordering::Relaxed)),
             created: self.created.clone(),
             scratch: insert::Scratch::default(),
+            segment: self.segment.clone(),
+            segments: self.segments.clone(),
+            chains: self.chains.clone(),
+            unblock_conforming: false,
+            label: self.label.clone(),
         }
     }
 }
@@ -152,6 +170,11 @@ impl Triangulation {
             hint: AtomicU32::new(0),
             created: Vec::new(),
             scratch: insert::Scratch::default(),
+            segment: Vec::new(),
+            segments: Vec::new(),
+            chains: Vec::new(),
+            unblock_conforming: false,
+            label: Vec::new(),
         }
     }
 

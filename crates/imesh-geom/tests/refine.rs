@@ -1,0 +1,272 @@
+//! Ruppert refinement on random PSLGs: conformity, labels, angles, termination.
+
+use imesh_geom::{
+    GeomError, Point, RefineOptions, StopReason, TriangleId, Triangulation, VertexId, EXTERIOR,
+};
+use proptest::prelude::*;
+
+/// The smallest angle of a triangle (degrees) and whether it sits between two segments.
+fn smallest(t: &Triangulation, f: TriangleId) -> (f64, bool) {
+    let p = t.triangle_points(f);
+    let e = t.triangle_edges(f);
+    let mut best = (f64::INFINITY, false);
+    for k in 0..3 {
+        let (o, u, w) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+        let (a, b) = (u - o, w - o);
+        let angle = (a.x * b.y - a.y * b.x)
+            .abs()
+            .atan2(a.x * b.x + a.y * b.y)
+            .to_degrees();
+        if angle < best.0 {
+            // The edges at corner k: e[k] leaves it, e[(k + 2) % 3] arrives.
+            best = (
+                angle,
+                t.is_constrained(e[k]) && t.is_constrained(e[(k + 2) % 3]),
+            );
+        }
+    }
+    best
+}
+
+fn assert_refined(t: &Triangulation, theta: f64) {
+    t.check().unwrap();
+    for f in t.triangles() {
+        if t.label(f) == EXTERIOR {
+            continue;
+        }
+        let (angle, input_corner) = smallest(t, f);
+        assert!(
+            angle >= theta - 1e-9 || input_corner,
+            "triangle {f:?} has angle {angle}° < {theta}°: {:?} label {}",
+            t.triangle_points(f),
+            t.label(f)
+        );
+    }
+}
+
+/// A star-shaped polygon around `c`, its vertices rounded to multiples of 1/64: imesh's boundaries
+/// lie on a dyadic lattice (pixel centres and their midpoints), where midpoint splits are exact.
+fn star(c: Point, radii: &[f64]) -> Vec<Point> {
+    let n = radii.len();
+    let snap = |v: f64| (v * 64.0).round() / 64.0;
+    (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            Point::new(
+                snap(c.x + radii[i] * a.cos()),
+                snap(c.y + radii[i] * a.sin()),
+            )
+        })
+        .collect()
+}
+
+fn inside(poly: &[Point], p: Point) -> bool {
+    let mut inside = false;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+fn centroid(t: &Triangulation, f: TriangleId) -> Point {
+    let [a, b, c] = t.triangle_points(f);
+    Point::new((a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn polygons_with_holes(outer in prop::collection::vec(6.0f64..10.0, 5..16), hole in prop::collection::vec(1.0f64..3.0, 3..8), theta in prop::sample::select(vec![20.7, 28.0, 33.0])) {
+        let c = Point::new(0.0, 0.0);
+        let (po, ph) = (star(c, &outer), star(c, &hole));
+        let mut pts = po.clone();
+        pts.extend(&ph);
+        let (mut t, ids) = Triangulation::from_points(&pts).unwrap();
+        for (first, n) in [(0, po.len()), (po.len(), ph.len())] {
+            for i in 0..n {
+                t.insert_segment(ids[first + i], ids[first + (i + 1) % n]).unwrap();
+            }
+        }
+        t.label_regions(&[(po[0].midpoint(Point::new(hole[0], 0.0)), 5)]);
+        let before = t.num_vertices();
+        let report = t.refine(&RefineOptions { min_angle_deg: theta, max_steiner: 20_000, ..Default::default() }).unwrap();
+        prop_assert_eq!(report.stopped, StopReason::Done);
+        prop_assert_eq!(t.num_vertices(), before + report.inserted);
+        assert_refined(&t, theta);
+        // (Slivers of rounding size between the hull and a boundary chain whose split points were
+        // nudged off a non-lattice segment cannot be judged by a point-in-polygon test.)
+        for f in t.triangles().filter(|&f| t.signed_area(f) > 1e-9) {
+            let p = centroid(&t, f);
+            let expect = if inside(&po, p) && !inside(&ph, p) { 5 } else { EXTERIOR };
+            prop_assert_eq!(t.label(f), expect, "triangle {:?} centroid {:?} area {}", t.triangle_points(f), p, t.signed_area(f));
+        }
+    }
+
+    #[test]
+    fn grid_boundaries_of_random_label_images(w in 2u32..9, h in 2u32..9, cells in prop::collection::vec(0u32..3, 81), theta in prop::sample::select(vec![20.7, 28.0, 33.0])) {
+        let label = |c: u32, r: u32| cells[(r * 9 + c) as usize];
+        // The PSLG: unit segments between pixels of different labels and on the border, and only
+        // the pixel corners they use (large empty regions, so refinement has work to do).
+        let mut segs: Vec<((u32, u32), (u32, u32))> = Vec::new();
+        for r in 0..=h {
+            for c in 0..w {
+                if r == 0 || r == h || label(c, r - 1) != label(c, r) {
+                    segs.push(((c, r), (c + 1, r)));
+                }
+            }
+        }
+        for c in 0..=w {
+            for r in 0..h {
+                if c == 0 || c == w || label(c - 1, r) != label(c, r) {
+                    segs.push(((c, r), (c, r + 1)));
+                }
+            }
+        }
+        let mut corners: Vec<(u32, u32)> = segs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        corners.sort_unstable();
+        corners.dedup();
+        let pts: Vec<Point> = corners.iter().map(|&(c, r)| Point::new(f64::from(c), f64::from(r))).collect();
+        let (mut t, ids) = Triangulation::from_points(&pts).unwrap();
+        let id = |p: (u32, u32)| ids[corners.binary_search(&p).unwrap()];
+        for &(p, q) in &segs {
+            t.insert_segment(id(p), id(q)).unwrap();
+        }
+        let seeds: Vec<(Point, u32)> = (0..h).flat_map(|r| (0..w).map(move |c| (Point::new(f64::from(c) + 0.5, f64::from(r) + 0.5), label(c, r)))).collect();
+        t.label_regions(&seeds);
+        let before = t.num_vertices();
+        let report = t.refine(&RefineOptions { min_angle_deg: theta, max_steiner: 20_000, ..Default::default() }).unwrap();
+        prop_assert_eq!(report.stopped, StopReason::Done);
+        prop_assert_eq!(t.num_vertices(), before + report.inserted);
+        assert_refined(&t, theta);
+        for f in t.triangles() {
+            let p = centroid(&t, f);
+            prop_assert_eq!(t.label(f), label(p.x as u32, p.y as u32));
+        }
+    }
+}
+
+#[test]
+fn a_checkerboard_boundary_needs_and_gets_refinement() {
+    // Corners of a 4 × 4 checkerboard's boundary only: long thin Delaunay triangles at first.
+    let pts: Vec<Point> = [
+        (0.0, 0.0),
+        (8.0, 0.0),
+        (8.0, 8.0),
+        (0.0, 8.0),
+        (4.0, 0.0),
+        (4.0, 8.0),
+        (0.0, 4.0),
+        (8.0, 4.0),
+        (4.0, 4.0),
+        (1.0, 7.0),
+    ]
+    .iter()
+    .map(|&(x, y)| Point::new(x, y))
+    .collect();
+    let (mut t, _) = Triangulation::from_points(&pts).unwrap();
+    let worst_before = t
+        .triangles()
+        .map(|f| smallest(&t, f).0)
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst_before < 20.0);
+    let r = t
+        .refine(&RefineOptions {
+            min_angle_deg: 33.0,
+            ..Default::default()
+        })
+        .unwrap();
+    assert!(r.inserted > 0 && r.bad_left == 0);
+    assert_refined(&t, 33.0);
+}
+
+#[test]
+fn angles_above_34_degrees_are_refused() {
+    let (mut t, _) = Triangulation::from_points(&[
+        Point::new(0.0, 0.0),
+        Point::new(1.0, 0.0),
+        Point::new(0.0, 1.0),
+    ])
+    .unwrap();
+    let e = t
+        .refine(&RefineOptions {
+            min_angle_deg: 35.0,
+            ..Default::default()
+        })
+        .unwrap_err();
+    assert_eq!(e, GeomError::BadAngle { degrees: 35.0 });
+    assert!(t
+        .refine(&RefineOptions {
+            min_angle_deg: 0.0,
+            ..Default::default()
+        })
+        .is_err());
+}
+
+#[test]
+fn the_cap_stops_refinement_and_says_so() {
+    let pts = [
+        Point::new(0.0, 0.0),
+        Point::new(100.0, 0.0),
+        Point::new(100.0, 1.0),
+        Point::new(0.0, 1.0),
+    ];
+    let (mut t, _) = Triangulation::from_points(&pts).unwrap();
+    let r = t
+        .refine(&RefineOptions {
+            min_angle_deg: 30.0,
+            max_steiner: 10,
+            ..Default::default()
+        })
+        .unwrap();
+    assert_eq!((r.inserted, r.stopped), (10, StopReason::CapReached));
+    t.check().unwrap();
+}
+
+#[test]
+fn maximum_area_is_honoured() {
+    let pts = [
+        Point::new(0.0, 0.0),
+        Point::new(10.0, 0.0),
+        Point::new(10.0, 10.0),
+        Point::new(0.0, 10.0),
+    ];
+    let (mut t, _) = Triangulation::from_points(&pts).unwrap();
+    t.refine(&RefineOptions {
+        min_angle_deg: 25.0,
+        max_area: Some(2.0),
+        ..Default::default()
+    })
+    .unwrap();
+    assert!(t.triangles().all(|f| t.signed_area(f) <= 2.0));
+    assert_refined(&t, 25.0);
+}
+
+#[test]
+fn a_policy_veto_splits_segments_instead() {
+    // A long thin rectangle: refusing every circumcentre leaves only segment splits.
+    let pts = [
+        Point::new(0.0, 0.0),
+        Point::new(20.0, 0.0),
+        Point::new(20.0, 1.0),
+        Point::new(0.0, 1.0),
+    ];
+    let (mut t, _) = Triangulation::from_points(&pts).unwrap();
+    let n = t.num_vertices();
+    let r = t
+        .refine_with_policy(&RefineOptions::default(), |_, _, _| false)
+        .unwrap();
+    t.check().unwrap();
+    // Every vertex added lies on the border.
+    for v in (n..t.num_vertices()).map(|i| VertexId::new(i as u32)) {
+        let p = t.point(v);
+        assert!(
+            p.x == 0.0 || p.x == 20.0 || p.y == 0.0 || p.y == 1.0,
+            "{p:?}"
+        );
+    }
+    assert!(r.inserted > 0);
+}
