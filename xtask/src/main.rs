@@ -2,22 +2,29 @@
 //!
 //! ```text
 //! cargo xtask bench delaunay [--runs N] [--quick]
+//! cargo xtask bench refine [--runs N]
 //! cargo xtask fixtures quality
 //! ```
 
 mod alloc;
 mod bench_delaunay;
+mod bench_refine;
 mod fixtures;
 
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
+       cargo xtask bench refine [--runs N]
        cargo xtask fixtures quality
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
                    writes target/bench/delaunay.json
     --runs N       timed runs per input and implementation (median reported; default 7)
     --quick        smaller inputs (10^4, 10^5 points, 316x316 grid) for a fast check
+
+  bench refine     Ruppert refinement of fixture label boundaries and a random planar graph at
+                   20.7°, 28° and 33°: ours against spade (and Triangle with --features triangle);
+                   writes target/bench/refine.json
 
   fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
                    vtkMeshQuality, installed from PyPI into target/venv-vtk";
@@ -56,6 +63,18 @@ fn run(args: &[String]) -> Result<(), String> {
                 }
             }
             bench_delaunay::run(&options)
+        }
+        ["bench", "refine", rest @ ..] => {
+            let runs = match rest {
+                [] => 3,
+                ["--runs", n] => n
+                    .parse()
+                    .ok()
+                    .filter(|&r: &usize| r > 0)
+                    .ok_or_else(|| format!("--runs takes a positive integer, not '{n}'"))?,
+                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+            };
+            bench_refine::run(runs)
         }
         ["fixtures", "quality"] => fixtures::quality(),
         [] | ["help"] | ["--help"] | ["-h"] => {

@@ -178,9 +178,15 @@ impl Triangulation {
             }
             if let Some([u, w]) = forced.pop() {
                 if let Some(h) = self.find_edge(VertexId(u), VertexId(w)) {
-                    self.split_segment(h.0, n_input)?;
-                    report.inserted += 1;
-                    self.after_insertion(min_angle, options.max_area, &mut heap, &mut encroached);
+                    if self.split_segment(h.0, n_input)? {
+                        report.inserted += 1;
+                        self.after_insertion(
+                            min_angle,
+                            options.max_area,
+                            &mut heap,
+                            &mut encroached,
+                        );
+                    }
                 }
                 continue;
             }
@@ -222,17 +228,31 @@ impl Triangulation {
             }
             match self.walk_to(t, c) {
                 Target::Blocked(h) => {
-                    forced.push([self.origin[h as usize], self.origin[next(h) as usize]]);
-                    heap.push(bad);
+                    if self.splittable(h) {
+                        forced.push([self.origin[h as usize], self.origin[next(h) as usize]]);
+                        heap.push(bad);
+                    } else {
+                        report.bad_left += 1;
+                    }
                 }
                 Target::Found => {
                     let threatened = self.segments_encroached_by(t, c);
-                    if !threatened.is_empty() {
+                    let splittable = threatened.iter().all(|&[u, w]| {
+                        self.find_edge(VertexId(u), VertexId(w))
+                            .is_some_and(|h| self.splittable(h.0))
+                    });
+                    if !threatened.is_empty() && !splittable {
+                        report.bad_left += 1;
+                    } else if !threatened.is_empty() {
                         forced.extend(threatened);
                         heap.push(bad);
                     } else if !policy(self, TriangleId(t), c) {
                         let holding = self.segments_encroached_by(t, c);
-                        if holding.is_empty() {
+                        let splittable = holding.iter().all(|&[u, w]| {
+                            self.find_edge(VertexId(u), VertexId(w))
+                                .is_some_and(|h| self.splittable(h.0))
+                        });
+                        if holding.is_empty() || !splittable {
                             report.bad_left += 1;
                         } else {
                             forced.extend(holding);
@@ -395,12 +415,35 @@ impl Triangulation {
         out
     }
 
-    /// Splits the constrained edge of half-edge `h` at its midpoint or concentric-shell point.
-    fn split_segment(&mut self, h: u32, n_input: u32) -> Result<(), GeomError> {
+    /// True when the constrained edge of `h` is long enough to split in floating point: at least
+    /// 1e-7 of its coordinates' magnitude. (Concentric-shell splitting near a tiny input angle can
+    /// otherwise shrink pieces until a computed split point is off the piece by a visible fraction of
+    /// its length; Triangle guards the same spot.)
+    fn splittable(&self, h: u32) -> bool {
+        let (a, b) = (
+            self.points[self.origin[h as usize] as usize],
+            self.points[self.origin[next(h) as usize] as usize],
+        );
+        let scale =
+            a.x.abs()
+                .max(a.y.abs())
+                .max(b.x.abs())
+                .max(b.y.abs())
+                .max(1.0);
+        a.distance_squared(b).sqrt() >= 1e-7 * scale
+    }
+
+    /// Splits the constrained edge of half-edge `h` at its midpoint or concentric-shell point;
+    /// false (nothing done) when the edge is too short to split.
+    fn split_segment(&mut self, h: u32, n_input: u32) -> Result<bool, GeomError> {
+        if !self.splittable(h) {
+            return Ok(false);
+        }
         let (u, w) = (self.origin[h as usize], self.origin[next(h) as usize]);
         let p = self.split_point(u, w, n_input);
+        let before = self.points.len();
         self.insert_on_edge(h, p)?;
-        Ok(())
+        Ok(self.points.len() > before)
     }
 
     /// True when the smallest angle of triangle `t`, at `corner`, lies between two segments: an

@@ -351,7 +351,8 @@ impl Triangulation {
             } else {
                 tri.segment[e as usize]
             };
-            let lifted = tri.unblock_conforming && seg != NONE && !tri.chains[seg as usize].is_empty();
+            let lifted =
+                tri.unblock_conforming && seg != NONE && !tri.chains[seg as usize].is_empty();
             seg != NONE && !lifted && Some(e) != split && Some(tri.twin[e as usize]) != split
         };
         let mut s = std::mem::take(&mut self.scratch);
@@ -375,7 +376,65 @@ impl Triangulation {
                 s.boundary.push((self.origin[e as usize], o, e));
             }
         }
+        if !self.segment.is_empty() && !self.cavity_is_star_shaped(&s.boundary, p) {
+            self.repair_cavity(&mut s, seed, p);
+        }
         self.scratch = s;
+    }
+
+    /// True when `p` sees every (real) boundary edge of the cavity strictly from inside.
+    fn cavity_is_star_shaped(&self, boundary: &[(u32, u32, u32)], p: Point) -> bool {
+        boundary.iter().all(|&(x, _, e)| {
+            let y = self.origin[next(e) as usize];
+            x == GHOST
+                || y == GHOST
+                || orient2d(self.points[x as usize], self.points[y as usize], p) > 0.0
+        })
+    }
+
+    /// Constraints can make the cavity reach, around the free end of a segment, triangles that `p`
+    /// cannot see; joining `p` to them would cross the segment. Drop the triangles owning boundary
+    /// edges `p` does not see strictly, keep what stays connected to the seed, and repeat until the
+    /// cavity is star-shaped from `p`. (The seed holds `p`, so it is never dropped.)
+    fn repair_cavity(&self, s: &mut Scratch, seed: u32, p: Point) {
+        let mut members: std::collections::HashSet<u32> = s.cavity.iter().copied().collect();
+        loop {
+            let hidden: Vec<u32> = s
+                .boundary
+                .iter()
+                .filter(|&&(x, _, e)| {
+                    let y = self.origin[next(e) as usize];
+                    x != GHOST
+                        && y != GHOST
+                        && orient2d(self.points[x as usize], self.points[y as usize], p) <= 0.0
+                })
+                .map(|&(_, _, e)| e / 3)
+                .filter(|&t| t != seed)
+                .collect();
+            if hidden.is_empty() {
+                return;
+            }
+            for t in hidden {
+                members.remove(&t);
+            }
+            s.cavity.clear();
+            s.boundary.clear();
+            s.stack.clear();
+            s.cavity.push(seed);
+            s.stack.extend([3 * seed + 2, 3 * seed + 1, 3 * seed]);
+            while let Some(e) = s.stack.pop() {
+                let o = self.twin[e as usize];
+                let t = o / 3;
+                if t != seed && members.contains(&t) && !s.cavity.contains(&t) {
+                    s.cavity.push(t);
+                    let n1 = next(o);
+                    s.stack.push(next(n1));
+                    s.stack.push(n1);
+                } else {
+                    s.boundary.push((self.origin[e as usize], o, e));
+                }
+            }
+        }
     }
 
     /// Replaces the cavity by the fan of triangles joining `v` to its boundary. When `split` is the
