@@ -48,22 +48,12 @@ struct Timings {
     delaunator: f64,
 }
 
-/// Uniform random points in the unit square scaled to 1000 (xorshift, fixed seed).
 fn uniform(n: usize, seed: u64) -> Vec<Point> {
-    let mut s = seed;
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 * 1000.0
-    };
-    (0..n).map(|_| Point::new(next(), next())).collect()
+    imesh_geom::sample::uniform_points(n, seed, 1000.0)
 }
 
 fn pixel_grid(side: u32) -> Vec<Point> {
-    (0..side)
-        .flat_map(|r| (0..side).map(move |c| Point::pixel_centre(c, r)))
-        .collect()
+    imesh_geom::sample::pixel_centres(side, side)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

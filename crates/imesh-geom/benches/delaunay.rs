@@ -9,20 +9,11 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use imesh_geom::{Point, Triangulation};
 
 fn uniform(n: usize) -> Vec<Point> {
-    let mut s = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 * 1000.0
-    };
-    (0..n).map(|_| Point::new(next(), next())).collect()
+    imesh_geom::sample::uniform_points(n, 0x2545_f491_4f6c_dd1d, 1000.0)
 }
 
 fn grid(side: u32) -> Vec<Point> {
-    (0..side)
-        .flat_map(|r| (0..side).map(move |c| Point::pixel_centre(c, r)))
-        .collect()
+    imesh_geom::sample::pixel_centres(side, side)
 }
 
 fn bulk(c: &mut Criterion) {

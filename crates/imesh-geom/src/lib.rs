@@ -28,6 +28,7 @@
 //! ```
 
 pub mod predicates;
+pub mod sample;
 pub mod spatial_sort;
 
 mod point;

@@ -53,6 +53,17 @@ impl Point {
         Point::new(f64::from(col) + 0.5, f64::from(row) + 0.5)
     }
 
+    /// The largest coordinate magnitude of `self` and `other`, at least 1: the scale of the
+    /// rounding errors of arithmetic on them.
+    pub(crate) fn magnitude_with(self, other: Point) -> f64 {
+        self.x
+            .abs()
+            .max(self.y.abs())
+            .max(other.x.abs())
+            .max(other.y.abs())
+            .max(1.0)
+    }
+
     pub(crate) fn to_robust(self) -> robust::Coord<f64> {
         robust::Coord {
             x: self.x,

@@ -137,10 +137,11 @@ impl Triangulation {
         self.refine_with_policy(options, |_, _, _| true)
     }
 
-    /// [`refine`](Self::refine), with a `policy` that may veto a circumcentre: called with the bad
-    /// triangle and its circumcentre (already known to be reachable without crossing a segment);
-    /// when it returns false the segments whose diametral circle holds the point are split instead
-    /// (or, if there are none, the triangle is left as it is).
+    /// [`refine`](Self::refine), with a `policy` that may veto a circumcentre. Circumcentres that lie
+    /// beyond a segment (outside the domain, or in another labelled region) or that encroach a
+    /// segment are never inserted: the segment is split instead, before the policy is asked. The
+    /// policy sees the rest — the bad triangle and a circumcentre reachable without crossing a
+    /// segment — and a veto leaves that triangle as it is (counted in `bad_left`).
     ///
     /// # Errors
     /// As [`refine`](Self::refine).
@@ -237,27 +238,15 @@ impl Triangulation {
                 }
                 Target::Found => {
                     let threatened = self.segments_encroached_by(t, c);
-                    let splittable = threatened.iter().all(|&[u, w]| {
-                        self.find_edge(VertexId(u), VertexId(w))
-                            .is_some_and(|h| self.splittable(h.0))
-                    });
-                    if !threatened.is_empty() && !splittable {
-                        report.bad_left += 1;
-                    } else if !threatened.is_empty() {
-                        forced.extend(threatened);
-                        heap.push(bad);
-                    } else if !policy(self, TriangleId(t), c) {
-                        let holding = self.segments_encroached_by(t, c);
-                        let splittable = holding.iter().all(|&[u, w]| {
-                            self.find_edge(VertexId(u), VertexId(w))
-                                .is_some_and(|h| self.splittable(h.0))
-                        });
-                        if holding.is_empty() || !splittable {
-                            report.bad_left += 1;
-                        } else {
-                            forced.extend(holding);
+                    if !threatened.is_empty() {
+                        if self.all_splittable(&threatened) {
+                            forced.extend(threatened);
                             heap.push(bad);
+                        } else {
+                            report.bad_left += 1;
                         }
+                    } else if !policy(self, TriangleId(t), c) {
+                        report.bad_left += 1;
                     } else {
                         let before = self.points.len();
                         self.insert(c)?;
@@ -424,13 +413,15 @@ impl Triangulation {
             self.points[self.origin[h as usize] as usize],
             self.points[self.origin[next(h) as usize] as usize],
         );
-        let scale =
-            a.x.abs()
-                .max(a.y.abs())
-                .max(b.x.abs())
-                .max(b.y.abs())
-                .max(1.0);
-        a.distance_squared(b).sqrt() >= 1e-7 * scale
+        a.distance_squared(b).sqrt() >= 1e-7 * a.magnitude_with(b)
+    }
+
+    /// True when every listed piece is still an edge long enough to split.
+    fn all_splittable(&self, pieces: &[[u32; 2]]) -> bool {
+        pieces.iter().all(|&[u, w]| {
+            self.find_edge(VertexId(u), VertexId(w))
+                .is_some_and(|h| self.splittable(h.0))
+        })
     }
 
     /// Splits the constrained edge of half-edge `h` at its midpoint or concentric-shell point;

@@ -4,6 +4,9 @@ use imesh_geom::predicates::incircle;
 use imesh_geom::{GeomError, Point, Triangulation, VertexId, EXTERIOR};
 use proptest::prelude::*;
 
+mod common;
+use common::{centroid, inside, star};
+
 /// Every segment is exactly the chain of constrained edges through its vertices, which lie on it
 /// (exactly for constrained segments, within rounding for conforming Steiner points).
 fn assert_segments_are_edge_chains(t: &Triangulation) {
@@ -170,28 +173,6 @@ fn a_vertex_on_a_segment_splits_it() {
     t.check().unwrap();
 }
 
-/// A star-shaped polygon (radius varying with angle) around `c`.
-fn star(c: Point, radii: &[f64]) -> Vec<Point> {
-    let n = radii.len();
-    (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            Point::new(c.x + radii[i] * a.cos(), c.y + radii[i] * a.sin())
-        })
-        .collect()
-}
-
-fn inside(poly: &[Point], p: Point) -> bool {
-    let mut inside = false;
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(60))]
 
@@ -218,9 +199,7 @@ proptest! {
         }
         t.check().unwrap();
         for f in t.triangles() {
-            let [a, b, cc] = t.triangle_points(f);
-            let centroid = Point::new((a.x + b.x + cc.x) / 3.0, (a.y + b.y + cc.y) / 3.0);
-            prop_assert_eq!(t.label(f), expect(centroid));
+            prop_assert_eq!(t.label(f), expect(centroid(&t, f)));
         }
     }
 }

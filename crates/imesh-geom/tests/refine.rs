@@ -5,6 +5,9 @@ use imesh_geom::{
 };
 use proptest::prelude::*;
 
+mod common;
+use common::{centroid, inside, star};
+
 /// The smallest angle of a triangle (degrees) and whether it sits between two segments.
 fn smallest(t: &Triangulation, f: TriangleId) -> (f64, bool) {
     let p = t.triangle_points(f);
@@ -42,38 +45,6 @@ fn assert_refined(t: &Triangulation, theta: f64) {
             t.label(f)
         );
     }
-}
-
-/// A star-shaped polygon around `c`, its vertices rounded to multiples of 1/64: imesh's boundaries
-/// lie on a dyadic lattice (pixel centres and their midpoints), where midpoint splits are exact.
-fn star(c: Point, radii: &[f64]) -> Vec<Point> {
-    let n = radii.len();
-    let snap = |v: f64| (v * 64.0).round() / 64.0;
-    (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            Point::new(
-                snap(c.x + radii[i] * a.cos()),
-                snap(c.y + radii[i] * a.sin()),
-            )
-        })
-        .collect()
-}
-
-fn inside(poly: &[Point], p: Point) -> bool {
-    let mut inside = false;
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
-fn centroid(t: &Triangulation, f: TriangleId) -> Point {
-    let [a, b, c] = t.triangle_points(f);
-    Point::new((a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0)
 }
 
 proptest! {

@@ -29,6 +29,7 @@ pub mod tri;
 mod stats;
 mod summary;
 mod validate;
+mod vec2;
 
 pub use stats::{Histogram, Statistics};
 pub use summary::{

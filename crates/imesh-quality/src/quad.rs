@@ -7,22 +7,11 @@
 //! The scale-invariant metrics work on coordinates divided by the bounding-box diagonal, which
 //! only moves Verdict's tiny-value thresholds.
 
+use crate::vec2::{cross, dot, sub};
 use crate::{Point2, DBL_MAX, DBL_MIN};
 
 /// A quadrilateral: four corners in order (either orientation).
 pub type Quad = [Point2; 4];
-
-fn sub(a: Point2, b: Point2) -> Point2 {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn cross(a: Point2, b: Point2) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
-}
-
-fn dot(a: Point2, b: Point2) -> f64 {
-    a[0] * b[0] + a[1] * b[1]
-}
 
 fn clamp(q: f64) -> f64 {
     q.clamp(-DBL_MAX, DBL_MAX)

@@ -3,22 +3,11 @@
 //! All triangle metrics are unsigned: Verdict cannot see an inverted triangle (the validator
 //! checks orientation).
 
+use crate::vec2::{cross, dot, sub};
 use crate::{Point2, DBL_MAX, DBL_MIN};
 
 /// A triangle: three corners in order (either orientation).
 pub type Triangle = [Point2; 3];
-
-fn sub(a: Point2, b: Point2) -> Point2 {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn cross(a: Point2, b: Point2) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
-}
-
-fn dot(a: Point2, b: Point2) -> f64 {
-    a[0] * b[0] + a[1] * b[1]
-}
 
 /// The bounding-box diagonal (Verdict's element scale; 1 for a point-like triangle).
 fn element_scale(t: &Triangle) -> f64 {

@@ -304,12 +304,7 @@ impl Triangulation {
             let d = b - a;
             let outward =
                 Point::new(d.y, -d.x) * (f64::EPSILON / d.x.hypot(d.y).max(f64::MIN_POSITIVE));
-            let scale =
-                a.x.abs()
-                    .max(a.y.abs())
-                    .max(b.x.abs())
-                    .max(b.y.abs())
-                    .max(1.0);
+            let scale = a.magnitude_with(b);
             let mut k = 1.0;
             while orient2d(a, b, p) > 0.0 && k < 1e6 {
                 p = p + outward * (k * scale);
@@ -356,6 +351,27 @@ impl Triangulation {
             seg != NONE && !lifted && Some(e) != split && Some(tri.twin[e as usize]) != split
         };
         let mut s = std::mem::take(&mut self.scratch);
+        self.grow_cavity(&mut s, seed, |e, t, _| {
+            // Across the edge being split the neighbour always goes: the point is on that edge (at
+            // least up to the rounding of a computed split point).
+            let across_split = split.is_some_and(|h| h == e || self.twin[h as usize] == e);
+            across_split || (!blocked(self, e) && self.in_cavity(t, p))
+        });
+        if !self.segment.is_empty() && !self.cavity_is_star_shaped(&s.boundary, p) {
+            self.repair_cavity(&mut s, seed, p);
+        }
+        self.scratch = s;
+    }
+
+    /// Depth-first search of the cavity from `seed`: `include(e, t, cavity)` says whether the
+    /// triangle `t` across half-edge `e` joins. Each triangle's edges are visited counter-clockwise,
+    /// so the boundary edges come out in counter-clockwise order.
+    fn grow_cavity(
+        &self,
+        s: &mut Scratch,
+        seed: u32,
+        mut include: impl FnMut(u32, u32, &[u32]) -> bool,
+    ) {
         s.cavity.clear();
         s.boundary.clear();
         s.stack.clear();
@@ -364,10 +380,7 @@ impl Triangulation {
         while let Some(e) = s.stack.pop() {
             let o = self.twin[e as usize];
             let t = o / 3;
-            // Across the edge being split the neighbour always goes: the point is on that edge (at
-            // least up to the rounding of a computed split point).
-            let across_split = split.is_some_and(|h| h == e || self.twin[h as usize] == e);
-            if across_split || (!blocked(self, e) && self.in_cavity(t, p)) {
+            if include(e, t, &s.cavity) {
                 s.cavity.push(t);
                 let n1 = next(o);
                 s.stack.push(next(n1));
@@ -376,10 +389,6 @@ impl Triangulation {
                 s.boundary.push((self.origin[e as usize], o, e));
             }
         }
-        if !self.segment.is_empty() && !self.cavity_is_star_shaped(&s.boundary, p) {
-            self.repair_cavity(&mut s, seed, p);
-        }
-        self.scratch = s;
     }
 
     /// True when `p` sees every (real) boundary edge of the cavity strictly from inside.
@@ -417,23 +426,9 @@ impl Triangulation {
             for t in hidden {
                 members.remove(&t);
             }
-            s.cavity.clear();
-            s.boundary.clear();
-            s.stack.clear();
-            s.cavity.push(seed);
-            s.stack.extend([3 * seed + 2, 3 * seed + 1, 3 * seed]);
-            while let Some(e) = s.stack.pop() {
-                let o = self.twin[e as usize];
-                let t = o / 3;
-                if t != seed && members.contains(&t) && !s.cavity.contains(&t) {
-                    s.cavity.push(t);
-                    let n1 = next(o);
-                    s.stack.push(next(n1));
-                    s.stack.push(n1);
-                } else {
-                    s.boundary.push((self.origin[e as usize], o, e));
-                }
-            }
+            self.grow_cavity(s, seed, |_, t, cavity| {
+                t != seed && members.contains(&t) && !cavity.contains(&t)
+            });
         }
     }
 
