@@ -177,24 +177,16 @@ impl Triangulation {
                 report.stopped = StopReason::CapReached;
                 break;
             }
-            if let Some([u, w]) = forced.pop() {
+            // Forced splits first, then splits of segments an existing vertex still encroaches.
+            let pending_split = forced
+                .pop()
+                .map(|s| (s, true))
+                .or_else(|| encroached.pop().map(|s| (s, false)));
+            if let Some(([u, w], forced_split)) = pending_split {
                 if let Some(h) = self.find_edge(VertexId(u), VertexId(w)) {
-                    if self.split_segment(h.0, n_input)? {
-                        report.inserted += 1;
-                        self.after_insertion(
-                            min_angle,
-                            options.max_area,
-                            &mut heap,
-                            &mut encroached,
-                        );
-                    }
-                }
-                continue;
-            }
-            if let Some([u, w]) = encroached.pop() {
-                if let Some(h) = self.find_edge(VertexId(u), VertexId(w)) {
-                    if self.is_encroached(h.0) {
-                        self.split_segment(h.0, n_input)?;
+                    if (forced_split || self.is_encroached(h.0))
+                        && self.split_segment(h.0, n_input)?
+                    {
                         report.inserted += 1;
                         self.after_insertion(
                             min_angle,
