@@ -63,7 +63,7 @@ impl Triangulation {
             return chain.iter().copied().map(VertexId).collect();
         }
         let [a, b] = self.segments[s.0 as usize];
-        let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
+        let pa = self.points[a as usize];
         let mut on: Vec<u32> = (0..self.points.len() as u32)
             .filter(|&v| v == a || v == b || self.on_open_segment(a, b, v))
             .collect();
@@ -71,7 +71,6 @@ impl Triangulation {
             pa.distance_squared(self.points[x as usize])
                 .total_cmp(&pa.distance_squared(self.points[y as usize]))
         });
-        let _ = pb;
         on.into_iter().map(VertexId).collect()
     }
 
@@ -479,12 +478,11 @@ impl Triangulation {
     /// exactly one end is an input vertex (ids below `n_input`).
     pub(crate) fn split_point(&self, u: u32, w: u32, n_input: u32) -> Point {
         let (pu, pw) = (self.points[u as usize], self.points[w as usize]);
-        let (apex, other, from_u) = match (u < n_input, w < n_input) {
-            (true, false) => (pu, pw, true),
-            (false, true) => (pw, pu, false),
+        let (apex, other) = match (u < n_input, w < n_input) {
+            (true, false) => (pu, pw),
+            (false, true) => (pw, pu),
             _ => return pu.midpoint(pw),
         };
-        let _ = from_u;
         let len = apex.distance_squared(other).sqrt();
         // The power of two nearest to half the length.
         let r = 2f64.powf((0.5 * len).log2().round());
