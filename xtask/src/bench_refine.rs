@@ -105,7 +105,6 @@ fn label_boundaries(file: &str) -> Result<Pslg, String> {
     })
 }
 
-#[allow(dead_code)] // kept for the bench once refinement handles tiny input angles (issue 3)
 /// 1000 segments: edges of the Delaunay triangulation of random integer points (planar by
 /// construction), taken every few edges.
 fn random_planar_graph() -> Result<Pslg, String> {
@@ -209,13 +208,10 @@ pub fn run(runs: usize) -> Result<(), String> {
     if cfg!(not(feature = "triangle")) {
         println!("Triangle: OFF (its licence keeps it out of default builds; run `cargo xtask bench refine` with `--features triangle` in the xtask: cargo run -p xtask --release --features triangle -- bench refine)");
     }
-    // The random 1000-segment planar graph (`random_planar_graph`) is not run yet: its many tiny
-    // input angles make our refinement cascade until the insertion cap (it needs Shewchuk's
-    // seditious-edge rule; see issue 3), which would make this table meaningless.
-    println!("random planar graph: not run (our refinement does not yet stop splitting near tiny input angles without the cap)");
     let pslgs = [
         label_boundaries("pyvista-channels_z050_labels.png")?,
         label_boundaries("stardist-mask2d_labels.png")?,
+        random_planar_graph()?,
     ];
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);

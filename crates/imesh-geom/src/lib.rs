@@ -36,7 +36,7 @@ mod refine;
 mod triangulation;
 
 pub use point::Point;
-pub use refine::{RefineOptions, RefineReport, StopReason};
+pub use refine::{Candidate, RefineOptions, RefineReport, StopReason};
 pub use triangulation::{
     HalfEdgeId, Location, SegmentId, TriangleId, Triangulation, TriangulationDefect, VertexId,
     EXTERIOR,

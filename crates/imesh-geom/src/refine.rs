@@ -15,7 +15,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use crate::predicates::orient2d;
-use crate::triangulation::{next, prev, NONE};
+use crate::triangulation::{next, prev, GHOST, NONE};
 use crate::{GeomError, Point, TriangleId, Triangulation, VertexId, EXTERIOR};
 
 /// Parameters of [`Triangulation::refine`].
@@ -88,10 +88,67 @@ impl Ord for Bad {
 
 /// Where the walk to a circumcentre ended.
 enum Target {
-    /// The point lies in a real triangle reached without crossing a segment.
-    Found,
-    /// A segment (or the hull) is in the way: its half-edge.
+    /// The point lies in this real triangle; `crossed` is the first segment half-edge crossed on
+    /// the way, if any.
+    Found { triangle: u32, crossed: Option<u32> },
+    /// The hull is in the way: its half-edge.
     Blocked(u32),
+    /// The walk did not arrive (a safeguard: it cannot happen on a valid triangulation).
+    Lost,
+}
+
+/// The sub-segment (pair of bounding input vertices) of every Steiner vertex refinement put on a
+/// segment: the frame of Shewchuk's concentric shells and seditious edges.
+struct Shells {
+    /// Vertices below this id are input vertices.
+    n_input: u32,
+    /// Indexed by vertex id minus `n_input`; `[NONE, NONE]` for free vertices.
+    ends: Vec<[u32; 2]>,
+}
+
+impl Shells {
+    fn record(&mut self, v: u32, ends: [u32; 2]) {
+        let i = (v - self.n_input) as usize;
+        if self.ends.len() <= i {
+            self.ends.resize(i + 1, [NONE; 2]);
+        }
+        self.ends[i] = ends;
+    }
+}
+
+/// Where to split a segment piece that a vertex of another segment encroaches.
+enum ShellSplit {
+    /// On the encroaching vertex's circle around the segments' common end.
+    At(Point),
+    /// Not at all: the piece already ends on that circle.
+    Skip,
+    /// At the usual midpoint or power-of-two shell point.
+    Usual,
+}
+
+/// What to do about one bad triangle.
+enum Plan {
+    /// Insert its circumcentre, which lies in this triangle.
+    Insert(u32),
+    /// Split these segment pieces first (the triangle is queued again).
+    Split(Vec<[u32; 2]>),
+    /// Leave the triangle as it is.
+    GiveUp,
+}
+
+/// A circumcentre that refinement is about to insert, as shown to a policy
+/// ([`Triangulation::refine_with_policy`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    /// The bad triangle being refined.
+    pub bad: TriangleId,
+    /// Its circumcentre.
+    pub point: Point,
+    /// The triangle that holds the circumcentre.
+    pub containing: TriangleId,
+    /// True when the straight path from the bad triangle to the circumcentre crosses a segment
+    /// (so `containing` may lie in another region).
+    pub crossed_segment: bool,
 }
 
 fn circumcentre(a: Point, b: Point, c: Point) -> Point {
@@ -134,21 +191,38 @@ impl Triangulation {
     /// t.check().unwrap();
     /// ```
     pub fn refine(&mut self, options: &RefineOptions) -> Result<RefineReport, GeomError> {
-        self.refine_with_policy(options, |_, _, _| true)
+        self.refine_with_policy(options, |_, _| true)
     }
 
-    /// [`refine`](Self::refine), with a `policy` that may veto a circumcentre. Circumcentres that lie
-    /// beyond a segment (outside the domain, or in another labelled region) or that encroach a
-    /// segment are never inserted: the segment is split instead, before the policy is asked. The
-    /// policy sees the rest — the bad triangle and a circumcentre reachable without crossing a
-    /// segment — and a veto leaves that triangle as it is (counted in `bad_left`).
+    /// [`refine`](Self::refine), with a `policy` that may veto a circumcentre. Circumcentres outside
+    /// the hull, in an [`EXTERIOR`] triangle, or encroaching a segment are never inserted: the
+    /// segment is split instead, before the policy is asked. The policy sees the rest as a
+    /// [`Candidate`]. A veto of a circumcentre that lies beyond a segment (in another region,
+    /// when the policy keeps regions apart) splits the first segment piece on the way to it; any
+    /// other veto leaves the triangle as it is (counted in `bad_left`).
+    ///
+    /// ```
+    /// use imesh_geom::{Point, RefineOptions, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(8.0, 0.0), Point::new(8.0, 8.0), Point::new(0.0, 8.0), Point::new(4.0, 0.0), Point::new(4.0, 8.0)];
+    /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    /// t.insert_segment(v[4], v[5]).unwrap();
+    /// t.label_regions(&[(Point::new(1.0, 4.0), 1), (Point::new(7.0, 4.0), 2)]);
+    /// // Keep every circumcentre in the region of its triangle.
+    /// t.refine_with_policy(&RefineOptions::default(), |t, c| t.label(c.containing) == t.label(c.bad))
+    ///     .unwrap();
+    /// assert!(t.triangles().all(|f| {
+    ///     let [a, b, c] = t.triangle_points(f);
+    ///     let x = (a.x + b.x + c.x) / 3.0;
+    ///     t.label(f) == if x < 4.0 { 1 } else { 2 }
+    /// }));
+    /// ```
     ///
     /// # Errors
     /// As [`refine`](Self::refine).
     pub fn refine_with_policy(
         &mut self,
         options: &RefineOptions,
-        mut policy: impl FnMut(&Triangulation, TriangleId, Point) -> bool,
+        mut policy: impl FnMut(&Triangulation, &Candidate) -> bool,
     ) -> Result<RefineReport, GeomError> {
         let deg = options.min_angle_deg;
         if !(deg > 0.0 && deg <= 34.0) {
@@ -165,6 +239,10 @@ impl Triangulation {
         self.constrain_hull()?;
         let min_angle = deg.to_radians();
         let n_input = self.points.len() as u32;
+        let mut shells = Shells {
+            n_input,
+            ends: Vec::new(),
+        };
         let mut heap = BinaryHeap::new();
         let all: Vec<u32> = (0..self.origin.len() as u32 / 3).collect();
         self.queue_bad(&all, min_angle, options.max_area, &mut heap);
@@ -183,9 +261,19 @@ impl Triangulation {
                 .map(|s| (s, true))
                 .or_else(|| encroached.pop().map(|s| (s, false)));
             if let Some(([u, w], forced_split)) = pending_split {
-                if let Some(h) = self.find_edge(VertexId(u), VertexId(w)) {
-                    if (forced_split || self.is_encroached(h.0))
-                        && self.split_segment(h.0, n_input)?
+                // (A stale pair may have become an unconstrained edge again.)
+                if let Some(h) = self
+                    .find_edge(VertexId(u), VertexId(w))
+                    .filter(|&h| self.is_constrained(h))
+                {
+                    // A forced split ignores existing encroachers: it makes room for a point.
+                    let encroacher = if forced_split {
+                        None
+                    } else {
+                        self.encroacher(h.0)
+                    };
+                    if (forced_split || encroacher.is_some())
+                        && self.split_segment(h.0, &mut shells, encroacher)?
                     {
                         report.inserted += 1;
                         self.after_insertion(
@@ -210,7 +298,8 @@ impl Triangulation {
             if angle >= min_angle && !too_big {
                 continue;
             }
-            if !too_big && self.is_input_angle(t, corner) {
+            if !too_big && (self.is_input_angle(t, corner) || self.is_seditious(t, corner, &shells))
+            {
                 report.bad_left += 1;
                 continue;
             }
@@ -219,40 +308,53 @@ impl Triangulation {
                 report.bad_left += 1;
                 continue;
             }
-            match self.walk_to(t, c) {
-                Target::Blocked(h) => {
-                    if self.splittable(h) {
-                        forced.push([self.origin[h as usize], self.origin[next(h) as usize]]);
-                        heap.push(bad);
+            let mut plan = match self.walk_to(t, c) {
+                Target::Lost => Plan::GiveUp,
+                Target::Blocked(h) => Plan::Split(vec![self.edge_ends(h)]),
+                Target::Found { triangle, crossed } => {
+                    let threatened = self.segments_encroached_by(triangle, c);
+                    if !threatened.is_empty() {
+                        Plan::Split(threatened)
                     } else {
-                        report.bad_left += 1;
+                        let candidate = Candidate {
+                            bad: TriangleId(t),
+                            point: c,
+                            containing: TriangleId(triangle),
+                            crossed_segment: crossed.is_some(),
+                        };
+                        let allowed = self.refinable(triangle) && policy(self, &candidate);
+                        match (allowed, crossed) {
+                            (true, _) => Plan::Insert(triangle),
+                            (false, Some(h)) => Plan::Split(vec![self.edge_ends(h)]),
+                            (false, None) => Plan::GiveUp,
+                        }
                     }
                 }
-                Target::Found => {
-                    let threatened = self.segments_encroached_by(t, c);
-                    if !threatened.is_empty() {
-                        if self.all_splittable(&threatened) {
-                            forced.extend(threatened);
-                            heap.push(bad);
-                        } else {
-                            report.bad_left += 1;
-                        }
-                    } else if !policy(self, TriangleId(t), c) {
-                        report.bad_left += 1;
+            };
+            if let Plan::Split(pieces) = &plan {
+                if !self.all_splittable(pieces) {
+                    plan = Plan::GiveUp;
+                }
+            }
+            match plan {
+                Plan::GiveUp => report.bad_left += 1,
+                Plan::Split(pieces) => {
+                    forced.extend(pieces);
+                    heap.push(bad);
+                }
+                Plan::Insert(triangle) => {
+                    let before = self.points.len();
+                    self.insert_near(c, TriangleId(triangle))?;
+                    if self.points.len() > before {
+                        report.inserted += 1;
+                        self.after_insertion(
+                            min_angle,
+                            options.max_area,
+                            &mut heap,
+                            &mut encroached,
+                        );
                     } else {
-                        let before = self.points.len();
-                        self.insert(c)?;
-                        if self.points.len() > before {
-                            report.inserted += 1;
-                            self.after_insertion(
-                                min_angle,
-                                options.max_area,
-                                &mut heap,
-                                &mut encroached,
-                            );
-                        } else {
-                            report.bad_left += 1;
-                        }
+                        report.bad_left += 1;
                     }
                 }
             }
@@ -352,18 +454,20 @@ impl Triangulation {
     /// True when the apex of a real refinable triangle beside constrained half-edge `e` lies strictly
     /// inside the edge's diametral circle.
     fn is_encroached(&self, e: u32) -> bool {
-        [e, self.twin[e as usize]].iter().any(|&h| {
-            let t = h / 3;
-            if !self.refinable(t) {
-                return false;
+        self.encroacher(e).is_some()
+    }
+
+    /// The apex of a real refinable triangle beside constrained half-edge `e` that lies strictly
+    /// inside the edge's diametral circle, if any.
+    fn encroacher(&self, e: u32) -> Option<u32> {
+        [e, self.twin[e as usize]].into_iter().find_map(|h| {
+            if !self.refinable(h / 3) {
+                return None;
             }
-            let [u, w, apex] = [
-                self.origin[h as usize],
-                self.origin[next(h) as usize],
-                self.origin[prev(h) as usize],
-            ]
-            .map(|v| self.points[v as usize]);
-            in_diametral_circle(u, w, apex)
+            let apex = self.origin[prev(h) as usize];
+            let [u, w, a] = [self.origin[h as usize], self.origin[next(h) as usize], apex]
+                .map(|v| self.points[v as usize]);
+            in_diametral_circle(u, w, a).then_some(apex)
         })
     }
 
@@ -418,15 +522,102 @@ impl Triangulation {
 
     /// Splits the constrained edge of half-edge `h` at its midpoint or concentric-shell point;
     /// false (nothing done) when the edge is too short to split.
-    fn split_segment(&mut self, h: u32, n_input: u32) -> Result<bool, GeomError> {
+    fn split_segment(
+        &mut self,
+        h: u32,
+        shells: &mut Shells,
+        encroacher: Option<u32>,
+    ) -> Result<bool, GeomError> {
         if !self.splittable(h) {
             return Ok(false);
         }
         let (u, w) = (self.origin[h as usize], self.origin[next(h) as usize]);
-        let p = self.split_point(u, w, n_input);
+        let n_input = shells.n_input;
+        let p = match encroacher.map_or(ShellSplit::Usual, |v| self.shell_split(h, v, shells)) {
+            ShellSplit::Skip => return Ok(false),
+            ShellSplit::At(p) => p,
+            ShellSplit::Usual => self.split_point(u, w, n_input),
+        };
+        let piece_ends = self.piece_ends(u, w, shells);
+        let p = self.snap_to_segment(h, p);
         let before = self.points.len();
-        self.insert_on_edge(h, p)?;
+        let v = self.insert_on_edge(h, p)?.0;
+        if self.points.len() > before {
+            shells.record(v, piece_ends);
+        }
         Ok(self.points.len() > before)
+    }
+
+    /// How to split the constrained edge of `h` encroached by vertex `v`. When `v` is a Steiner
+    /// vertex of another segment meeting this one at an input vertex `a`, the edge is split at
+    /// `v`'s distance from `a` (when that lies well inside the edge): the two vertices then sit on
+    /// one circle around `a`, the edge joining them is seditious, and the mutual encroachment of
+    /// two segments at a small angle stops there instead of halving both forever (Triangle does
+    /// the same). When an end of the edge already sits on `v`'s circle, the encroachment is an
+    /// artefact of rounding the shell points, and splitting would only halve the edge towards
+    /// `v` without end: it is not split.
+    fn shell_split(&self, h: u32, v: u32, shells: &Shells) -> ShellSplit {
+        let (u, w) = (self.origin[h as usize], self.origin[next(h) as usize]);
+        let (Some([a0, a1]), Some([b0, b1])) = (
+            Some(self.piece_ends(u, w, shells)),
+            self.sub_segment(v, shells),
+        ) else {
+            return ShellSplit::Usual;
+        };
+        if [a0, a1] == [b0, b1] || [a0, a1] == [b1, b0] {
+            return ShellSplit::Usual;
+        }
+        let apex = if a0 == b0 || a0 == b1 {
+            a0
+        } else if a1 == b0 || a1 == b1 {
+            a1
+        } else {
+            return ShellSplit::Usual;
+        };
+        let [pa, pu, pw, pv] = [
+            apex,
+            self.origin[h as usize],
+            self.origin[next(h) as usize],
+            v,
+        ]
+        .map(|x| self.points[x as usize]);
+        let (du, dw, r) = (
+            pa.distance_squared(pu).sqrt(),
+            pa.distance_squared(pw).sqrt(),
+            pa.distance_squared(pv).sqrt(),
+        );
+        if (du - r).abs() <= 1e-3 * r || (dw - r).abs() <= 1e-3 * r {
+            return ShellSplit::Skip;
+        }
+        let f = (r - du) / (dw - du);
+        if f.is_finite() && (0.2..=0.8).contains(&f) {
+            ShellSplit::At(pu + (pw - pu) * f)
+        } else {
+            ShellSplit::Usual
+        }
+    }
+
+    /// `p` (a split point of the constrained edge of `h`) moved onto the exact line of its input
+    /// segment when possible: its parameter along the segment, rounded to a multiple of 2^-36, gives
+    /// an exactly representable point on the line whenever the segment's ends lie on a coarse
+    /// lattice (pixel corners and centres). Split points computed from Steiner ends would drift off
+    /// the line by rounding; on the hull that drift changes the hull.
+    fn snap_to_segment(&self, h: u32, p: Point) -> Point {
+        let [a, b] =
+            self.segments[self.segment[h as usize] as usize].map(|v| self.points[v as usize]);
+        let d = b - a;
+        let f = ((p.x - a.x) * d.x + (p.y - a.y) * d.y) / (d.x * d.x + d.y * d.y);
+        let scale = 2f64.powi(36);
+        let q = a + d * ((f * scale).round() / scale);
+        let (u, w) = (
+            self.points[self.origin[h as usize] as usize],
+            self.points[self.origin[next(h) as usize] as usize],
+        );
+        if orient2d(a, b, q) == 0.0 && crate::predicates::strictly_between(u, w, q) {
+            q
+        } else {
+            p
+        }
     }
 
     /// True when the smallest angle of triangle `t`, at `corner`, lies between two segments: an
@@ -440,37 +631,152 @@ impl Triangulation {
         self.segment[leave as usize] != NONE && self.segment[arrive as usize] != NONE
     }
 
-    /// Walks the straight line from triangle `t`'s centroid to `c`.
+    /// True when the edge opposite the smallest angle of triangle `t` (at `corner`) is *seditious*
+    /// (Shewchuk): its ends are Steiner points on two segments that meet at an input vertex at
+    /// less than 60°, at the same distance from it (the same concentric shell). Splitting such a
+    /// triangle only inserts a point that encroaches one of the two segments again, whose split
+    /// makes a shorter seditious edge: the cascade that keeps Ruppert's algorithm from stopping at
+    /// small input angles. Such triangles are left as they are.
+    fn is_seditious(&self, t: u32, corner: usize, shells: &Shells) -> bool {
+        if self.segment.is_empty() {
+            return false;
+        }
+        let opposite = 3 * t + (corner as u32 + 1) % 3;
+        let (u, w) = (
+            self.origin[opposite as usize],
+            self.origin[next(opposite) as usize],
+        );
+        let (Some([a0, a1]), Some([b0, b1])) =
+            (self.sub_segment(u, shells), self.sub_segment(w, shells))
+        else {
+            return false;
+        };
+        if [a0, a1] == [b0, b1] || [a0, a1] == [b1, b0] {
+            return false;
+        }
+        let (apex, eu, ew) = if a0 == b0 || a0 == b1 {
+            (a0, a1, if a0 == b0 { b1 } else { b0 })
+        } else if a1 == b0 || a1 == b1 {
+            (a1, a0, if a1 == b0 { b1 } else { b0 })
+        } else {
+            return false;
+        };
+        let [pa, pu, pw] = [apex, u, w].map(|v| self.points[v as usize]);
+        let (du, dw) = (
+            pa.distance_squared(pu).sqrt(),
+            pa.distance_squared(pw).sqrt(),
+        );
+        if !(du < 1.001 * dw && dw < 1.001 * du) {
+            return false;
+        }
+        // The segments' angle at the apex, from their far ends: below 60° (cos > 1/2).
+        let (x, y) = (self.points[eu as usize] - pa, self.points[ew as usize] - pa);
+        let dot = x.x * y.x + x.y * y.y;
+        dot > 0.0 && 4.0 * dot * dot > (x.x * x.x + x.y * x.y) * (y.x * y.x + y.y * y.y)
+    }
+
+    /// The two input vertices between which Steiner vertex `v` lies on its segment (the segment's
+    /// ends, or input vertices lying on it), if `v` is a Steiner vertex on a segment.
+    fn sub_segment(&self, v: u32, shells: &Shells) -> Option<[u32; 2]> {
+        if v < shells.n_input {
+            return None;
+        }
+        if let Some(&ends) = shells.ends.get((v - shells.n_input) as usize) {
+            if ends[0] != NONE {
+                return Some(ends);
+            }
+        }
+        // Not split by refinement (a circumcentre that landed on a segment): follow the segment's
+        // pieces both ways to the first input vertices.
+        let s = self
+            .star(v)
+            .map(|h| self.segment[h as usize])
+            .find(|&s| s != NONE)?;
+        let mut ends = [NONE; 2];
+        let mut k = 0;
+        for first in self.star(v).filter(|&h| self.segment[h as usize] == s) {
+            let (mut from, mut at) = (v, self.origin[next(first) as usize]);
+            while at != GHOST && at >= shells.n_input && k < 2 {
+                let Some(step) = self
+                    .star(at)
+                    .filter(|&h| self.segment[h as usize] == s)
+                    .map(|h| self.origin[next(h) as usize])
+                    .find(|&x| x != from)
+                else {
+                    break;
+                };
+                (from, at) = (at, step);
+            }
+            if k < 2 {
+                ends[k] = at;
+                k += 1;
+            }
+        }
+        (k == 2 && ends.iter().all(|&e| e < shells.n_input)).then_some(ends)
+    }
+
+    /// The input vertices bounding the piece `u w` of a segment (its sub-segment).
+    fn piece_ends(&self, u: u32, w: u32, shells: &Shells) -> [u32; 2] {
+        self.sub_segment(u, shells)
+            .or_else(|| self.sub_segment(w, shells))
+            .unwrap_or([u, w])
+    }
+
+    /// Walks from triangle `t`'s centroid towards `c` along the straight line, crossing only edges
+    /// (never passing through a vertex), so that every chain of segments between the two is met.
+    /// Where the line runs exactly through a vertex, the step crosses another edge that has `c`
+    /// strictly beyond it instead (a visibility-walk step, which still moves towards `c`). Interior
+    /// segments are crossed (the first one is remembered); the hull stops the walk.
     fn walk_to(&self, t: u32, c: Point) -> Target {
         let [a, b, d] = self.triangle_points(TriangleId(t));
         let g = Point::new((a.x + b.x + d.x) / 3.0, (a.y + b.y + d.y) / 3.0);
         let mut t = t;
         let mut entered = NONE;
-        for _ in 0..self.origin.len() {
-            let mut exit = None;
-            for e in 3 * t..3 * t + 3 {
-                if e == entered {
-                    continue;
-                }
-                let (x, y) = (
+        let mut crossed = None;
+        for step in 0..self.origin.len() {
+            let ends = |e: u32| {
+                (
                     self.points[self.origin[e as usize] as usize],
                     self.points[self.origin[next(e) as usize] as usize],
-                );
-                // c beyond this edge, and the line g → c passes between its ends (half-open at y).
-                if orient2d(x, y, c) < 0.0 && orient2d(g, c, x) >= 0.0 && orient2d(g, c, y) < 0.0 {
-                    exit = Some(e);
-                    break;
-                }
-            }
-            let Some(e) = exit else { return Target::Found };
+                )
+            };
+            let beyond = |e: u32| {
+                let (x, y) = ends(e);
+                orient2d(x, y, c) < 0.0
+            };
+            // c beyond the edge, and the line g → c passes between its ends (half-open at y).
+            let straight = (3 * t..3 * t + 3).find(|&e| {
+                let (x, y) = ends(e);
+                e != entered && beyond(e) && orient2d(g, c, x) >= 0.0 && orient2d(g, c, y) < 0.0
+            });
+            // Otherwise any edge with c strictly beyond, tried from a rotating start.
+            let exit = straight.or_else(|| {
+                (0..3)
+                    .map(|k| 3 * t + (k + step as u32) % 3)
+                    .find(|&e| e != entered && beyond(e))
+            });
+            let Some(e) = exit else {
+                return Target::Found {
+                    triangle: t,
+                    crossed,
+                };
+            };
             let o = self.twin[e as usize];
-            if self.segment[e as usize] != NONE || self.is_ghost_slot(o / 3) {
+            if self.is_ghost_slot(o / 3) {
                 return Target::Blocked(e);
+            }
+            if self.segment[e as usize] != NONE && crossed.is_none() {
+                crossed = Some(e);
             }
             entered = o;
             t = o / 3;
         }
-        Target::Found
+        Target::Lost
+    }
+
+    /// The two end vertices of half-edge `h`.
+    fn edge_ends(&self, h: u32) -> [u32; 2] {
+        [self.origin[h as usize], self.origin[next(h) as usize]]
     }
 }
 

@@ -203,3 +203,27 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_refused_segment_leaves_nothing_behind() {
+    // The new segment runs through vertex 4 before it would cross segment 0–2: the piece up to
+    // vertex 4 must not stay constrained when the whole segment is refused.
+    let pts = [
+        Point::new(0.0, 0.0),
+        Point::new(8.0, 0.0),
+        Point::new(8.0, 8.0),
+        Point::new(0.0, 8.0),
+        Point::new(6.0, 2.0),
+    ];
+    let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    t.insert_segment(v[0], v[2]).unwrap();
+    let before = t.constrained_edges().count();
+    let e = t.insert_segment(v[1], v[3]).unwrap_err();
+    assert!(matches!(
+        e,
+        GeomError::CrossingSegments { existing_id: 0, .. }
+    ));
+    assert_eq!(t.constrained_edges().count(), before);
+    assert_eq!(t.num_segments(), 1);
+    t.check().unwrap();
+}

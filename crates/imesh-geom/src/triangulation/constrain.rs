@@ -31,6 +31,14 @@ enum Step {
     Crosses(u32),
 }
 
+/// The piece of a segment from one vertex to the next vertex on it.
+enum Piece {
+    /// It runs along this half-edge, to this vertex.
+    Edge(u32, u32),
+    /// It crosses these edges, to this vertex.
+    Crossing { crossed: Vec<[u32; 2]>, end: u32 },
+}
+
 impl Triangulation {
     /// Makes the per-half-edge segment array exist.
     fn ensure_constraint_storage(&mut self) {
@@ -62,16 +70,24 @@ impl Triangulation {
         if !chain.is_empty() {
             return chain.iter().copied().map(VertexId).collect();
         }
+        // Follow the segment's pieces from its first end: at each vertex, the constrained edge of
+        // this segment that does not lead back.
         let [a, b] = self.segments[s.0 as usize];
-        let pa = self.points[a as usize];
-        let mut on: Vec<u32> = (0..self.points.len() as u32)
-            .filter(|&v| v == a || v == b || self.on_open_segment(a, b, v))
-            .collect();
-        on.sort_by(|&x, &y| {
-            pa.distance_squared(self.points[x as usize])
-                .total_cmp(&pa.distance_squared(self.points[y as usize]))
-        });
-        on.into_iter().map(VertexId).collect()
+        let mut out = vec![VertexId(a)];
+        let (mut v, mut from) = (a, NONE);
+        while v != b && out.len() <= self.points.len() {
+            let Some(w) = self
+                .star(v)
+                .filter(|&h| self.segment[h as usize] == s.0)
+                .map(|h| self.origin[next(h) as usize])
+                .find(|&w| w != from && w != GHOST)
+            else {
+                break;
+            };
+            out.push(VertexId(w));
+            (from, v) = (v, w);
+        }
+        out
     }
 
     /// Number of input segments.
@@ -176,8 +192,8 @@ impl Triangulation {
     /// Delaunay). A vertex lying on the segment splits it: each piece is its own chain of edges.
     ///
     /// # Errors
-    /// [`GeomError::CrossingSegments`] when it crosses an earlier segment (nothing is changed then
-    /// except the pieces before the crossing); [`GeomError::BadSegment`] for equal or unknown
+    /// [`GeomError::CrossingSegments`] when it crosses or overlaps an earlier segment (nothing is
+    /// changed then); [`GeomError::BadSegment`] for equal or unknown
     /// vertices, or a triangulation without triangles.
     ///
     /// ```
@@ -192,6 +208,14 @@ impl Triangulation {
     pub fn insert_segment(&mut self, a: VertexId, b: VertexId) -> Result<SegmentId, GeomError> {
         self.validate_segment(a, b)?;
         self.ensure_constraint_storage();
+        // Trace the whole segment first, so that a crossing leaves the triangulation unchanged.
+        let mut from = a.0;
+        while from != b.0 {
+            from = match self.trace_piece(from, b.0)? {
+                Piece::Edge(_, c) => c,
+                Piece::Crossing { end, .. } => end,
+            };
+        }
         let id = self.segments.len() as u32;
         self.segments.push([a.0, b.0]);
         self.chains.push(Vec::new());
@@ -223,14 +247,21 @@ impl Triangulation {
         }
     }
 
-    /// Makes the piece of segment `id` from `a` towards `b` an edge, up to the first vertex on the
-    /// segment; returns that vertex.
-    fn constrain_piece(&mut self, a: u32, b: u32, id: u32) -> Result<u32, GeomError> {
+    /// Traces the piece of a segment from `a` towards `b` up to the first vertex on it, without
+    /// changing anything: the edge it runs along, or the edges it crosses.
+    fn trace_piece(&self, a: u32, b: u32) -> Result<Piece, GeomError> {
         let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
         let crossing = match self.first_step(a, b) {
             Some(Step::AlongEdge(h, c)) => {
-                self.mark(h, id, a, c)?;
-                return Ok(c);
+                if let Some(&s) = self.segment.get(h as usize).filter(|&&s| s != NONE) {
+                    // The same piece already belongs to another segment: overlapping segments.
+                    return Err(GeomError::CrossingSegments {
+                        new: [a, b],
+                        existing: self.segments[s as usize],
+                        existing_id: s,
+                    });
+                }
+                return Ok(Piece::Edge(h, c));
             }
             Some(Step::Crosses(e)) => e,
             None => {
@@ -244,7 +275,7 @@ impl Triangulation {
         // Walk along the segment collecting the edges it crosses, up to b or a vertex on it.
         let mut crossed: Vec<[u32; 2]> = Vec::new();
         let mut e = crossing;
-        let end = loop {
+        loop {
             if let Some(&s) = self.segment.get(e as usize).filter(|&&s| s != NONE) {
                 return Err(GeomError::CrossingSegments {
                     new: [a, b],
@@ -258,7 +289,7 @@ impl Triangulation {
             let px = self.points[x as usize];
             let side = orient2d(pa, pb, px);
             if x == b || side == 0.0 {
-                break x;
+                return Ok(Piece::Crossing { crossed, end: x });
             }
             // Beyond the crossed edge lies the triangle (w, u, x): the walk leaves it through u → x
             // or x → w, whichever has its ends on opposite sides of the segment's line.
@@ -270,6 +301,19 @@ impl Triangulation {
             } else {
                 n1
             };
+        }
+    }
+
+    /// Makes the piece of segment `id` from `a` towards `b` an edge, up to the first vertex on the
+    /// segment; returns that vertex.
+    fn constrain_piece(&mut self, a: u32, b: u32, id: u32) -> Result<u32, GeomError> {
+        let pa = self.points[a as usize];
+        let (crossed, end) = match self.trace_piece(a, b)? {
+            Piece::Edge(h, c) => {
+                self.mark(h, id, a, c)?;
+                return Ok(c);
+            }
+            Piece::Crossing { crossed, end } => (crossed, end),
         };
         // Sloan: flip crossing edges until none crosses; a flip is only legal on a strictly convex
         // quadrilateral, so non-convex ones wait for their turn.
@@ -467,11 +511,6 @@ impl Triangulation {
                 return Ok(());
             }
         }
-    }
-
-    fn on_open_segment(&self, u: u32, w: u32, v: u32) -> bool {
-        let [pu, pw, pv] = [u, w, v].map(|x| self.points[x as usize]);
-        orient2d(pu, pw, pv) == 0.0 && strictly_between(pu, pw, pv)
     }
 
     /// Where to split the piece `u w` of a segment: the midpoint, or a concentric-shell point when

@@ -136,6 +136,23 @@ impl Triangulation {
         }
     }
 
+    /// [`insert`](Self::insert), starting the point location at triangle `near` (a triangle that
+    /// holds `p` or is close to it makes the location immediate).
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let (mut t, _) = Triangulation::from_points(&[Point::new(0.0, 0.0), Point::new(4.0, 0.0), Point::new(0.0, 4.0)]).unwrap();
+    /// let f = t.triangles().next().unwrap();
+    /// let v = t.insert_near(Point::new(1.0, 1.0), f).unwrap();
+    /// assert_eq!(t.point(v), Point::new(1.0, 1.0));
+    /// ```
+    pub fn insert_near(&mut self, p: Point, near: TriangleId) -> Result<VertexId, GeomError> {
+        if 3 * near.index() < self.origin.len() {
+            self.hint.store(near.0, Ordering::Relaxed);
+        }
+        self.insert(p)
+    }
+
     /// The real triangles created by the last [`insert`](Self::insert) (they replace the triangles
     /// whose circumcircle held the new point). Empty after [`from_points`](Self::from_points).
     pub fn created_triangles(&self) -> &[TriangleId] {
@@ -297,10 +314,6 @@ impl Triangulation {
                 self.points[self.origin[real as usize] as usize],
                 self.points[self.origin[next(real) as usize] as usize],
             );
-            // The midpoint of lattice ends is exact: prefer it to a rounded shell point.
-            if orient2d(a, b, p) != 0.0 && orient2d(a, b, a.midpoint(b)) == 0.0 {
-                p = a.midpoint(b);
-            }
             let d = b - a;
             let outward =
                 Point::new(d.y, -d.x) * (f64::EPSILON / d.x.hypot(d.y).max(f64::MIN_POSITIVE));
