@@ -580,6 +580,22 @@ impl Triangulation {
         }
     }
 
+    /// The real triangles around vertex `v`, counter-clockwise.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(2.0, 0.0), Point::new(2.0, 2.0), Point::new(0.0, 2.0), Point::new(1.0, 1.0)];
+    /// let (t, v) = Triangulation::from_points(&pts).unwrap();
+    /// assert_eq!(t.vertex_triangles(v[4]).count(), 4);
+    /// assert_eq!(t.vertex_triangles(v[0]).count(), 1);
+    /// ```
+    pub fn vertex_triangles(&self, v: VertexId) -> impl Iterator<Item = TriangleId> + '_ {
+        self.star(v.0)
+            .map(|h| h / 3)
+            .filter(|&t| !self.is_ghost_slot(t))
+            .map(TriangleId)
+    }
+
     /// Gives every triangle the label `labels(t)` (e.g. carried from another labelled mesh).
     pub fn set_labels(&mut self, mut labels: impl FnMut(TriangleId) -> u32) {
         self.label = (0..self.origin.len() as u32 / 3)

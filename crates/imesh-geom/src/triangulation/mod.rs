@@ -199,6 +199,18 @@ impl Triangulation {
         self.origin.len() / 3 - self.ghost_count
     }
 
+    /// Number of triangle slots, real and ghost: every [`TriangleId`] indexes below it, so arrays
+    /// indexed by [`TriangleId::index`] need this length.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let (t, _) = Triangulation::from_points(&[Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(0.0, 1.0)]).unwrap();
+    /// assert_eq!(t.num_triangle_slots(), 4); // one real triangle and three ghosts
+    /// ```
+    pub fn num_triangle_slots(&self) -> usize {
+        self.origin.len() / 3
+    }
+
     /// Number of edges on the convex hull (0 while all vertices are collinear).
     pub fn num_hull_edges(&self) -> usize {
         self.ghost_count
