@@ -1,0 +1,173 @@
+//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label), VTK XML
+//! `.vtu` (cell data: label), SVG pictures and JSON. Every file is written atomically (a temporary
+//! file in the same directory, renamed into place), so a failed run never leaves half a file.
+//!
+//! Meshes come in image coordinates (y down, elements counter-clockwise there); writers emit the
+//! y-up frame `(x·sx, (H − y)·sy)` with every element counter-clockwise in it.
+//!
+//! ```
+//! use imesh_io::{write_msh, Frame, SegmentedMeshData};
+//! use imesh_quality::Element;
+//! let mesh = SegmentedMeshData {
+//!     vertices: vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
+//!     elements: vec![Element::Quad([0, 1, 2, 3])],
+//!     labels: vec![0],
+//!     label_names: vec!["steel".into()],
+//!     label_colours: vec![[200, 200, 200]],
+//!     width: 2,
+//!     height: 1,
+//! };
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("plate.msh");
+//! write_msh(&path, &mesh, &Frame::default()).unwrap();
+//! let text = std::fs::read_to_string(&path).unwrap();
+//! assert!(text.starts_with("$MeshFormat\n4.1 0 8\n"));
+//! assert!(text.contains("2 1 \"steel\""));
+//! ```
+
+mod msh;
+mod svg;
+mod vtu;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use imesh_quality::Element;
+
+pub use msh::{msh_string, write_msh};
+pub use svg::{svg_string, write_svg, SvgOptions};
+pub use vtu::{vtu_string, write_vtu};
+
+/// A labelled 2D mesh as the writers take it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegmentedMeshData {
+    /// Vertex positions in image coordinates (pixels, y down).
+    pub vertices: Vec<[f64; 2]>,
+    /// Triangles and quads, counter-clockwise in image coordinates.
+    pub elements: Vec<Element>,
+    /// A label per element (an index into `label_names`).
+    pub labels: Vec<u32>,
+    /// The name of each label.
+    pub label_names: Vec<String>,
+    /// The display colour of each label.
+    pub label_colours: Vec<[u8; 3]>,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+/// The written frame: y up, scaled by a physical pixel size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Size of a pixel along x and y (default 1).
+    pub pixel_size: [f64; 2],
+}
+
+impl Default for Frame {
+    fn default() -> Self {
+        Self {
+            pixel_size: [1.0, 1.0],
+        }
+    }
+}
+
+impl Frame {
+    /// A vertex in the written frame.
+    pub fn map(&self, mesh: &SegmentedMeshData, p: [f64; 2]) -> [f64; 2] {
+        [
+            p[0] * self.pixel_size[0],
+            (f64::from(mesh.height) - p[1]) * self.pixel_size[1],
+        ]
+    }
+}
+
+/// An element's corners in the written frame's counter-clockwise order (flipping y reverses the
+/// orientation, so the order is reversed, keeping the first corner).
+pub fn written_corners(e: &Element) -> Vec<u32> {
+    let c = e.corners();
+    std::iter::once(c[0])
+        .chain(c[1..].iter().rev().copied())
+        .collect()
+}
+
+/// A write that failed.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The file or its temporary could not be written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The mesh breaks an invariant the format needs.
+    #[error("refusing to write {path}: {reason}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// Writes `contents` to `path` atomically: a temporary file in the same directory, flushed, then
+/// renamed over `path`.
+///
+/// # Errors
+/// [`WriteError::Io`] when the directory is not writable or the disk is full.
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), WriteError> {
+    let io = |source| WriteError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
+    tmp.write_all(contents).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    // Temporary files are private; the result is an ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(io)?;
+    }
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+/// Checks what every writer needs: labels for every element, known vertices.
+pub(crate) fn check(path: &Path, mesh: &SegmentedMeshData) -> Result<(), WriteError> {
+    let invalid = |reason: String| WriteError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    if mesh.labels.len() != mesh.elements.len() {
+        return Err(invalid(format!(
+            "{} labels for {} elements",
+            mesh.labels.len(),
+            mesh.elements.len()
+        )));
+    }
+    let n = mesh.vertices.len() as u32;
+    if mesh
+        .elements
+        .iter()
+        .any(|e| e.corners().iter().any(|&v| v >= n))
+    {
+        return Err(invalid("an element refers to a missing vertex".into()));
+    }
+    if let Some(&l) = mesh
+        .labels
+        .iter()
+        .find(|&&l| l as usize >= mesh.label_names.len())
+    {
+        return Err(invalid(format!("label {l} has no name")));
+    }
+    Ok(())
+}

@@ -1,0 +1,111 @@
+//! Gmsh MSH 4.1 ASCII: one surface entity and one named physical surface per label.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use imesh_quality::Element;
+
+use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+
+/// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
+/// each on its own surface entity carrying the physical surface `label + 1` named after the
+/// label.
+pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
+    let mut s = String::new();
+    // Writing to a String cannot fail; the results are ignored on purpose.
+    let _ = writeln!(s, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
+    let used: Vec<u32> = {
+        let mut u = mesh.labels.clone();
+        u.sort_unstable();
+        u.dedup();
+        u
+    };
+    let _ = writeln!(s, "$PhysicalNames\n{}", used.len());
+    for &l in &used {
+        let name = mesh.label_names[l as usize].replace('"', "'");
+        let _ = writeln!(s, "2 {} \"{}\"", l + 1, name);
+    }
+    let _ = writeln!(s, "$EndPhysicalNames");
+    let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(mesh, p)).collect();
+    let (lo, hi) = bounds(&mapped);
+    let _ = writeln!(s, "$Entities\n0 0 {} 0", used.len());
+    for &l in &used {
+        let _ = writeln!(
+            s,
+            "{} {} {} 0 {} {} 0 1 {} 0",
+            l + 1,
+            lo[0],
+            lo[1],
+            hi[0],
+            hi[1],
+            l + 1
+        );
+    }
+    let _ = writeln!(s, "$EndEntities");
+    let n = mapped.len();
+    let entity = used.first().map_or(1, |&l| l + 1);
+    let _ = writeln!(s, "$Nodes\n1 {n} 1 {n}\n2 {entity} 0 {n}");
+    for i in 1..=n {
+        let _ = writeln!(s, "{i}");
+    }
+    for p in &mapped {
+        let _ = writeln!(s, "{} {} 0", p[0], p[1]);
+    }
+    let _ = writeln!(s, "$EndNodes");
+    // Blocks: per label, per element type.
+    let mut blocks: Vec<(u32, u32, Vec<usize>)> = Vec::new();
+    for &l in &used {
+        for kind in [2u32, 3] {
+            let members: Vec<usize> = (0..mesh.elements.len())
+                .filter(|&i| mesh.labels[i] == l && gmsh_type(&mesh.elements[i]) == kind)
+                .collect();
+            if !members.is_empty() {
+                blocks.push((l, kind, members));
+            }
+        }
+    }
+    let m = mesh.elements.len();
+    let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len());
+    let mut tag = 1usize;
+    for (l, kind, members) in &blocks {
+        let _ = writeln!(s, "2 {} {kind} {}", l + 1, members.len());
+        for &i in members {
+            let _ = write!(s, "{tag}");
+            for v in written_corners(&mesh.elements[i]) {
+                let _ = write!(s, " {}", v + 1);
+            }
+            s.push('\n');
+            tag += 1;
+        }
+    }
+    let _ = writeln!(s, "$EndElements");
+    s
+}
+
+/// Writes `mesh` as Gmsh MSH 4.1 ASCII, atomically.
+///
+/// # Errors
+/// [`WriteError`] when the mesh is inconsistent or the file cannot be written.
+pub fn write_msh(path: &Path, mesh: &SegmentedMeshData, frame: &Frame) -> Result<(), WriteError> {
+    check(path, mesh)?;
+    write_atomic(path, msh_string(mesh, frame).as_bytes())
+}
+
+fn gmsh_type(e: &Element) -> u32 {
+    match e {
+        Element::Triangle(_) => 2,
+        Element::Quad(_) => 3,
+    }
+}
+
+pub(crate) fn bounds(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+    points.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        },
+    )
+}

@@ -1,0 +1,89 @@
+//! SVG pictures: elements filled with their label's colour, edges drawn, optionally over the
+//! image. SVG's own frame is y-down like the image, so coordinates are pixels as they are.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::vtu::xml_escape;
+use crate::{check, write_atomic, SegmentedMeshData, WriteError};
+
+/// How to draw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SvgOptions {
+    /// An image drawn underneath (a path or URL the SVG refers to), if any.
+    pub background: Option<String>,
+    /// Opacity of the element fill (0 to 1; lower shows more of the background).
+    pub fill_opacity: f64,
+    /// Edge width in pixels.
+    pub stroke_width: f64,
+}
+
+impl Default for SvgOptions {
+    fn default() -> Self {
+        Self {
+            background: None,
+            fill_opacity: 1.0,
+            stroke_width: 0.1,
+        }
+    }
+}
+
+/// The SVG text of `mesh`.
+pub fn svg_string(mesh: &SegmentedMeshData, options: &SvgOptions) -> String {
+    let (w, h) = (mesh.width, mesh.height);
+    let mut s = String::new();
+    let scale = (1200.0 / f64::from(w.max(h).max(1))).max(1.0);
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" viewBox=\"0 0 {w} {h}\" width=\"{}\" height=\"{}\">",
+        f64::from(w) * scale,
+        f64::from(h) * scale
+    );
+    if let Some(bg) = &options.background {
+        let _ = writeln!(
+            s,
+            "<image href=\"{}\" x=\"0\" y=\"0\" width=\"{w}\" height=\"{h}\" style=\"image-rendering:pixelated\"/>",
+            xml_escape(bg)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<g stroke=\"#202020\" stroke-width=\"{}\" stroke-linejoin=\"round\" fill-opacity=\"{}\">",
+        options.stroke_width, options.fill_opacity
+    );
+    for (e, &l) in mesh.elements.iter().zip(&mesh.labels) {
+        let [r, g, b] = mesh
+            .label_colours
+            .get(l as usize)
+            .copied()
+            .unwrap_or([128; 3]);
+        let points: Vec<String> = e
+            .corners()
+            .iter()
+            .map(|&v| {
+                let p = mesh.vertices[v as usize];
+                format!("{:.4},{:.4}", p[0], p[1])
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "<polygon points=\"{}\" fill=\"#{r:02x}{g:02x}{b:02x}\"/>",
+            points.join(" ")
+        );
+    }
+    let _ = writeln!(s, "</g>\n</svg>");
+    s
+}
+
+/// Writes the SVG picture of `mesh`, atomically.
+///
+/// # Errors
+/// [`WriteError`] when the mesh is inconsistent or the file cannot be written.
+pub fn write_svg(
+    path: &Path,
+    mesh: &SegmentedMeshData,
+    options: &SvgOptions,
+) -> Result<(), WriteError> {
+    check(path, mesh)?;
+    write_atomic(path, svg_string(mesh, options).as_bytes())
+}

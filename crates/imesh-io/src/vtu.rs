@@ -1,0 +1,111 @@
+//! VTK XML unstructured grid (`.vtu`, ASCII), with a label and any extra values per cell.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use imesh_quality::Element;
+
+use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+
+/// The `.vtu` text of `mesh`, with cell data `label` and each `(name, values)` of `cell_data`.
+pub fn vtu_string(
+    mesh: &SegmentedMeshData,
+    frame: &Frame,
+    cell_data: &[(String, Vec<f64>)],
+) -> String {
+    let mut s = String::new();
+    let (n, m) = (mesh.vertices.len(), mesh.elements.len());
+    let _ = writeln!(
+        s,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{m}\">"
+    );
+    let _ = writeln!(
+        s,
+        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+    );
+    for &p in &mesh.vertices {
+        let q = frame.map(mesh, p);
+        let _ = writeln!(s, "{} {} 0", q[0], q[1]);
+    }
+    let _ = writeln!(s, "</DataArray>\n</Points>\n<Cells>");
+    let _ = writeln!(
+        s,
+        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    );
+    for e in &mesh.elements {
+        let c: Vec<String> = written_corners(e).iter().map(u32::to_string).collect();
+        let _ = writeln!(s, "{}", c.join(" "));
+    }
+    let _ = writeln!(
+        s,
+        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    );
+    let mut offset = 0;
+    for e in &mesh.elements {
+        offset += e.corners().len();
+        let _ = writeln!(s, "{offset}");
+    }
+    let _ = writeln!(
+        s,
+        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    );
+    for e in &mesh.elements {
+        let kind = match e {
+            Element::Triangle(_) => 5,
+            Element::Quad(_) => 9,
+        };
+        let _ = writeln!(s, "{kind}");
+    }
+    let _ = writeln!(s, "</DataArray>\n</Cells>\n<CellData Scalars=\"label\">");
+    let _ = writeln!(
+        s,
+        "<DataArray type=\"Int32\" Name=\"label\" format=\"ascii\">"
+    );
+    for l in &mesh.labels {
+        let _ = writeln!(s, "{l}");
+    }
+    let _ = writeln!(s, "</DataArray>");
+    for (name, values) in cell_data {
+        let _ = writeln!(
+            s,
+            "<DataArray type=\"Float64\" Name=\"{}\" format=\"ascii\">",
+            xml_escape(name)
+        );
+        for v in values {
+            let _ = writeln!(s, "{v}");
+        }
+        let _ = writeln!(s, "</DataArray>");
+    }
+    let _ = writeln!(s, "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>");
+    s
+}
+
+/// Writes `mesh` as a VTK XML unstructured grid, atomically.
+///
+/// # Errors
+/// [`WriteError`] when the mesh or the cell data are inconsistent or the file cannot be written.
+pub fn write_vtu(
+    path: &Path,
+    mesh: &SegmentedMeshData,
+    frame: &Frame,
+    cell_data: &[(String, Vec<f64>)],
+) -> Result<(), WriteError> {
+    check(path, mesh)?;
+    if let Some((name, _)) = cell_data
+        .iter()
+        .find(|(_, v)| v.len() != mesh.elements.len())
+    {
+        return Err(WriteError::Invalid {
+            path: path.to_path_buf(),
+            reason: format!("cell data {name} does not have one value per element"),
+        });
+    }
+    write_atomic(path, vtu_string(mesh, frame, cell_data).as_bytes())
+}
+
+pub(crate) fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}

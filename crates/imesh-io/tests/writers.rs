@@ -1,0 +1,152 @@
+//! The writers: y-up counter-clockwise output, exact areas, atomic failure.
+
+use imesh_io::{msh_string, vtu_string, write_msh, written_corners, Frame, SegmentedMeshData};
+use imesh_quality::Element;
+use proptest::prelude::*;
+
+/// A `w × h` grid of unit squares, each split into two triangles, labelled by column parity.
+fn grid_mesh(w: u32, h: u32) -> SegmentedMeshData {
+    let id = |c: u32, r: u32| r * (w + 1) + c;
+    let vertices = (0..=h)
+        .flat_map(|r| (0..=w).map(move |c| [f64::from(c), f64::from(r)]))
+        .collect();
+    let mut elements = Vec::new();
+    let mut labels = Vec::new();
+    for r in 0..h {
+        for c in 0..w {
+            // Counter-clockwise in image coordinates (positive signed area with y down).
+            elements.push(Element::Triangle([
+                id(c, r),
+                id(c + 1, r),
+                id(c + 1, r + 1),
+            ]));
+            elements.push(Element::Triangle([
+                id(c, r),
+                id(c + 1, r + 1),
+                id(c, r + 1),
+            ]));
+            labels.extend([c % 2, c % 2]);
+        }
+    }
+    SegmentedMeshData {
+        vertices,
+        elements,
+        labels,
+        label_names: vec!["even".into(), "odd".into()],
+        label_colours: vec![[0, 0, 0], [255, 255, 255]],
+        width: w,
+        height: h,
+    }
+}
+
+/// Parses the nodes and elements back from MSH 4.1 text.
+fn parse_msh(text: &str) -> (Vec<[f64; 2]>, Vec<Vec<usize>>, Vec<String>) {
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |tag: &str| lines.iter().position(|l| *l == tag).unwrap();
+    let names: Vec<String> = {
+        let i = at("$PhysicalNames");
+        let n: usize = lines[i + 1].parse().unwrap();
+        lines[i + 2..i + 2 + n]
+            .iter()
+            .map(|l| l.to_string())
+            .collect()
+    };
+    let i = at("$Nodes");
+    let n: usize = lines[i + 1].split(' ').nth(1).unwrap().parse().unwrap();
+    let coords = &lines[i + 3 + n..i + 3 + 2 * n];
+    let nodes = coords
+        .iter()
+        .map(|l| {
+            let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1]]
+        })
+        .collect();
+    let i = at("$Elements");
+    let mut elements = Vec::new();
+    let mut k = i + 2;
+    while lines[k] != "$EndElements" {
+        let count: usize = lines[k].split(' ').nth(3).unwrap().parse().unwrap();
+        for l in &lines[k + 1..k + 1 + count] {
+            let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
+            elements.push(v);
+        }
+        k += 1 + count;
+    }
+    (nodes, elements, names)
+}
+
+fn signed_area(p: &[[f64; 2]]) -> f64 {
+    (0..p.len())
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+proptest! {
+    #[test]
+    fn msh_is_y_up_counter_clockwise_and_covers_the_scaled_domain(w in 1u32..8, h in 1u32..8, sx in 0.1f64..3.0, sy in 0.1f64..3.0) {
+        let mesh = grid_mesh(w, h);
+        let frame = Frame { pixel_size: [sx, sy] };
+        let (nodes, elements, names) = parse_msh(&msh_string(&mesh, &frame));
+        prop_assert_eq!(nodes.len(), mesh.vertices.len());
+        prop_assert_eq!(elements.len(), mesh.elements.len());
+        prop_assert_eq!(names.len(), if w > 1 { 2 } else { 1 });
+        let mut total = 0.0;
+        for e in &elements {
+            let p: Vec<[f64; 2]> = e.iter().map(|&v| nodes[v - 1]).collect();
+            let a = signed_area(&p);
+            prop_assert!(a > 0.0, "element {:?} is clockwise in the written frame", e);
+            total += a;
+        }
+        let want = f64::from(w) * sx * f64::from(h) * sy;
+        prop_assert!((total - want).abs() <= 1e-9 * want);
+        // y up: image row 0 is at the top.
+        prop_assert_eq!(nodes[0][1], f64::from(h) * sy);
+    }
+}
+
+#[test]
+fn written_corners_reverse_the_order_but_keep_the_first() {
+    assert_eq!(
+        written_corners(&Element::Quad([4, 5, 6, 7])),
+        vec![4, 7, 6, 5]
+    );
+    assert_eq!(
+        written_corners(&Element::Triangle([1, 2, 3])),
+        vec![1, 3, 2]
+    );
+}
+
+#[test]
+fn vtu_has_every_cell_with_its_label() {
+    let mesh = grid_mesh(3, 2);
+    let text = vtu_string(&mesh, &Frame::default(), &[("shape".into(), vec![1.0; 12])]);
+    assert!(text.contains("NumberOfPoints=\"12\" NumberOfCells=\"12\""));
+    assert!(text.contains("Name=\"label\""));
+    assert!(text.contains("Name=\"shape\""));
+    // Twelve triangles: VTK cell type 5, one per line (no other line is a lone 5 here).
+    assert_eq!(text.lines().filter(|l| *l == "5").count(), 12);
+}
+
+#[test]
+fn a_failed_write_leaves_no_file_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no/such/dir/out.msh");
+    let e = write_msh(&missing, &grid_mesh(2, 2), &Frame::default()).unwrap_err();
+    assert!(e.to_string().contains("cannot write"));
+    assert!(!missing.exists());
+    // An inconsistent mesh is refused before anything is written.
+    let mut bad = grid_mesh(2, 2);
+    bad.labels.pop();
+    let path = dir.path().join("bad.msh");
+    assert!(write_msh(&path, &bad, &Frame::default()).is_err());
+    assert!(!path.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "a temporary file was left"
+    );
+}

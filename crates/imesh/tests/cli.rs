@@ -1,0 +1,200 @@
+//! The `imesh` program end to end on fixtures: outputs, exit codes, error messages, no half files.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name)
+}
+
+fn imesh(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_imesh"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the imesh binary runs")
+}
+
+/// The counts of an MSH 4.1 file: nodes, elements, physical names.
+fn msh_counts(text: &str) -> (usize, usize, usize) {
+    let lines: Vec<&str> = text.lines().collect();
+    let after = |tag: &str| {
+        let i = lines
+            .iter()
+            .position(|l| *l == tag)
+            .expect("section present");
+        lines[i + 1]
+    };
+    let field = |line: &str, k: usize| line.split(' ').nth(k).unwrap().parse::<usize>().unwrap();
+    (
+        field(after("$Nodes"), 1),
+        field(after("$Elements"), 1),
+        after("$PhysicalNames").parse().unwrap(),
+    )
+}
+
+#[test]
+fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("pyvista-channels_z050_labels.png");
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "--svg",
+            "m.svg",
+            "--report",
+            "m.json",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The default output: the image's name with .msh, in the working directory.
+    let msh = std::fs::read_to_string(dir.path().join("pyvista-channels_z050_labels.msh")).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("m.json")).unwrap()).unwrap();
+    let (nodes, elements, names) = msh_counts(&msh);
+    assert_eq!(nodes as u64, report["counts"]["vertices"].as_u64().unwrap());
+    assert_eq!(
+        elements as u64,
+        report["counts"]["elements"].as_u64().unwrap()
+    );
+    assert_eq!(
+        names, 5,
+        "one physical surface per label of the 5-label map"
+    );
+    assert_eq!(report["validation"]["valid"], true);
+    assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    assert!(report["label_agreement"].as_f64().unwrap() > 0.97);
+    assert!(std::fs::read_to_string(dir.path().join("m.svg"))
+        .unwrap()
+        .contains("<polygon"));
+}
+
+#[test]
+fn vtu_output_and_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coins.png");
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "-o",
+            "coins.vtu",
+            "--te",
+            "0.2",
+            "--min-angle",
+            "20",
+            "--pixel-size",
+            "0.5",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.is_empty(), "--quiet prints nothing");
+    let vtu = std::fs::read_to_string(dir.path().join("coins.vtu")).unwrap();
+    assert!(vtu.contains("Name=\"label\"") && vtu.contains("Name=\"shape\""));
+}
+
+#[test]
+fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coins.png");
+    let image = image.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["mesh", "missing.png"], "missing.png"),
+        (&["mesh", image, "-o", "out.obj"], ".msh"),
+        (&["mesh", image, "--te", "2"], "t_e"),
+        (&["mesh", image, "--min-angle", "40"], "34"),
+        (&["mesh", image, "--elements", "quad"], "quad"),
+    ];
+    for (args, hint) in cases {
+        let out = imesh(args, dir.path());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(hint), "{args:?}: {err}");
+    }
+    // A file that is not an image.
+    std::fs::write(dir.path().join("notes.png"), b"not a png").unwrap();
+    let out = imesh(&["mesh", "notes.png"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(
+        left,
+        vec![std::ffi::OsString::from("notes.png")],
+        "no output was left behind"
+    );
+}
+
+#[test]
+fn a_config_file_sets_options_and_unknown_keys_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("matplotlib-s1045_mri.png");
+    std::fs::write(dir.path().join("good.toml"), "te = 0.3\nmin_angle = 22.0\n").unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "tee = 0.3\n").unwrap();
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "--config",
+            "good.toml",
+            "--report",
+            "r.json",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["options"]["te"], 0.3);
+    assert_eq!(report["options"]["min_angle"], 22.0);
+    let out = imesh(
+        &["mesh", image.to_str().unwrap(), "--config", "bad.toml"],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("tee"));
+}
+
+#[test]
+fn classify_writes_a_label_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coffee.png");
+    let out = imesh(
+        &[
+            "classify",
+            image.to_str().unwrap(),
+            "--classify",
+            "kmeans:3",
+            "-o",
+            "labels.png",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("3 labels"));
+    assert!(dir.path().join("labels.png").exists());
+}

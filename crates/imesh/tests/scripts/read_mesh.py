@@ -1,0 +1,30 @@
+"""Reads a mesh with meshio and prints what it found as JSON (used by tests/interop.rs)."""
+import json
+import sys
+
+import meshio
+
+mesh = meshio.read(sys.argv[1])
+cells = {}
+for block in mesh.cells:
+    cells[block.type] = cells.get(block.type, 0) + int(len(block.data))
+labels = sorted({int(v) for block in mesh.cell_data.get("label", []) for v in block})
+physical = sorted({int(v) for block in mesh.cell_data.get("gmsh:physical", []) for v in block})
+# Signed areas in the file's frame: every element must be counter-clockwise.
+negative = 0
+area = 0.0
+for block in mesh.cells:
+    for cell in block.data:
+        p = mesh.points[cell][:, :2]
+        a = 0.5 * sum(p[i - 1][0] * p[i][1] - p[i][0] * p[i - 1][1] for i in range(len(p)))
+        negative += a <= 0
+        area += a
+print(json.dumps({
+    "points": int(len(mesh.points)),
+    "cells": cells,
+    "labels": labels,
+    "physical": physical,
+    "names": sorted(mesh.field_data.keys()),
+    "negative": int(negative),
+    "area": float(area),
+}))
