@@ -116,6 +116,18 @@ impl Shells {
     }
 }
 
+/// The work refinement has queued, and the criteria that fill the queues.
+struct Queues {
+    /// Bad triangles, worst first.
+    heap: BinaryHeap<Bad>,
+    /// Segment pieces an existing vertex encroaches.
+    encroached: Vec<[u32; 2]>,
+    /// The angle bound, in radians.
+    min_angle: f64,
+    /// The area bound.
+    max_area: Option<f64>,
+}
+
 /// Where to split a segment piece that a vertex of another segment encroaches.
 enum ShellSplit {
     /// On the encroaching vertex's circle around the segments' common end.
@@ -243,10 +255,14 @@ impl Triangulation {
             n_input,
             ends: Vec::new(),
         };
-        let mut heap = BinaryHeap::new();
         let all: Vec<u32> = (0..self.origin.len() as u32 / 3).collect();
-        self.queue_bad(&all, min_angle, options.max_area, &mut heap);
-        let mut encroached: Vec<[u32; 2]> = self.encroached_among(&all);
+        let mut queues = Queues {
+            heap: BinaryHeap::new(),
+            encroached: self.encroached_among(&all),
+            min_angle,
+            max_area: options.max_area,
+        };
+        self.queue_bad(&all, &mut queues);
         // Segments that must be split whether or not a vertex encroaches them now: they block a
         // circumcentre, or the circumcentre would encroach them.
         let mut forced: Vec<[u32; 2]> = Vec::new();
@@ -259,7 +275,7 @@ impl Triangulation {
             let pending_split = forced
                 .pop()
                 .map(|s| (s, true))
-                .or_else(|| encroached.pop().map(|s| (s, false)));
+                .or_else(|| queues.encroached.pop().map(|s| (s, false)));
             if let Some(([u, w], forced_split)) = pending_split {
                 // (A stale pair may have become an unconstrained edge again.)
                 if let Some(h) = self
@@ -275,18 +291,12 @@ impl Triangulation {
                     if (forced_split || encroacher.is_some())
                         && self.split_segment(h.0, &mut shells, encroacher)?
                     {
-                        report.inserted += 1;
-                        self.after_insertion(
-                            min_angle,
-                            options.max_area,
-                            &mut heap,
-                            &mut encroached,
-                        );
+                        self.after_insertion(&mut queues, &mut report);
                     }
                 }
                 continue;
             }
-            let Some(bad) = heap.pop() else { break };
+            let Some(bad) = queues.heap.pop() else { break };
             let Some(t) = self.triangle_with(bad.vertices) else {
                 continue;
             };
@@ -340,19 +350,13 @@ impl Triangulation {
                 Plan::GiveUp => report.bad_left += 1,
                 Plan::Split(pieces) => {
                     forced.extend(pieces);
-                    heap.push(bad);
+                    queues.heap.push(bad);
                 }
                 Plan::Insert(triangle) => {
                     let before = self.points.len();
                     self.insert_near(c, TriangleId(triangle))?;
                     if self.points.len() > before {
-                        report.inserted += 1;
-                        self.after_insertion(
-                            min_angle,
-                            options.max_area,
-                            &mut heap,
-                            &mut encroached,
-                        );
+                        self.after_insertion(&mut queues, &mut report);
                     } else {
                         report.bad_left += 1;
                     }
@@ -395,23 +399,20 @@ impl Triangulation {
         (self.origin[prev(h) as usize] == v[2]).then_some(h / 3)
     }
 
-    fn queue_bad(
-        &self,
-        triangles: &[u32],
-        min_angle: f64,
-        max_area: Option<f64>,
-        heap: &mut BinaryHeap<Bad>,
-    ) {
+    /// Queues the bad triangles among `triangles`.
+    fn queue_bad(&self, triangles: &[u32], queues: &mut Queues) {
         for &t in triangles {
             if !self.refinable(t) {
                 continue;
             }
             let p = self.triangle_points(TriangleId(t));
             let (angle, _) = smallest_angle(p);
-            let too_big = max_area.is_some_and(|m| self.signed_area(TriangleId(t)) > m);
-            if angle < min_angle || too_big {
+            let too_big = queues
+                .max_area
+                .is_some_and(|m| self.signed_area(TriangleId(t)) > m);
+            if angle < queues.min_angle || too_big {
                 let b = 3 * t as usize;
-                heap.push(Bad {
+                queues.heap.push(Bad {
                     key: angle,
                     vertices: [self.origin[b], self.origin[b + 1], self.origin[b + 2]],
                 });
@@ -419,17 +420,13 @@ impl Triangulation {
         }
     }
 
-    /// After an insertion: queue the new bad triangles and the segments their vertices encroach.
-    fn after_insertion(
-        &self,
-        min_angle: f64,
-        max_area: Option<f64>,
-        heap: &mut BinaryHeap<Bad>,
-        encroached: &mut Vec<[u32; 2]>,
-    ) {
+    /// After an insertion: count it, queue the new bad triangles and the segments their vertices
+    /// encroach.
+    fn after_insertion(&self, queues: &mut Queues, report: &mut RefineReport) {
+        report.inserted += 1;
         let created: Vec<u32> = self.created.iter().map(|t| t.0).collect();
-        self.queue_bad(&created, min_angle, max_area, heap);
-        encroached.extend(self.encroached_among(&created));
+        self.queue_bad(&created, queues);
+        queues.encroached.extend(self.encroached_among(&created));
     }
 
     /// Constrained edges of these triangles that are encroached by an adjacent apex.

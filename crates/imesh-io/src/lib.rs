@@ -1,5 +1,6 @@
-//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label), VTK XML
-//! `.vtu` (cell data: label), SVG pictures and JSON. Every file is written atomically (a temporary
+//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label and a
+//! physical curve per boundary), VTK XML `.vtu` and legacy `.vtk` (cell data: label and quality),
+//! Abaqus `.inp` (an element set per label, a node set per boundary) and SVG pictures. Every file is written atomically (a temporary
 //! file in the same directory, renamed into place), so a failed run never leaves half a file.
 //!
 //! Meshes come in image coordinates (y down, elements counter-clockwise there); writers emit the
@@ -25,8 +26,11 @@
 //! assert!(text.contains("2 1 \"steel\""));
 //! ```
 
+mod boundary;
+mod inp;
 mod msh;
 mod svg;
+mod vtk;
 mod vtu;
 
 use std::io::Write;
@@ -34,8 +38,11 @@ use std::path::{Path, PathBuf};
 
 use imesh_quality::Element;
 
+pub use boundary::{boundaries, sanitize, Boundary, OUTSIDE};
+pub use inp::{inp_string, write_inp};
 pub use msh::{msh_string, write_msh};
 pub use svg::{svg_string, write_svg, SvgOptions};
+pub use vtk::{vtk_string, write_vtk};
 pub use vtu::{vtu_string, write_vtu};
 
 /// A labelled 2D mesh as the writers take it.

@@ -5,11 +5,13 @@ use std::path::Path;
 
 use imesh_quality::Element;
 
+use crate::boundary::boundaries;
 use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
 
 /// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
 /// each on its own surface entity carrying the physical surface `label + 1` named after the
-/// label.
+/// label, then the boundary edges as lines, one curve entity and named physical curve per
+/// boundary (between two labels, or between a label and the domain border).
 pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut s = String::new();
     // Writing to a String cannot fail; the results are ignored on purpose.
@@ -20,7 +22,11 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         u.dedup();
         u
     };
-    let _ = writeln!(s, "$PhysicalNames\n{}", used.len());
+    let curves = boundaries(mesh);
+    let _ = writeln!(s, "$PhysicalNames\n{}", used.len() + curves.len());
+    for (i, b) in curves.iter().enumerate() {
+        let _ = writeln!(s, "1 {} \"{}\"", i + 1, b.name(mesh));
+    }
     for &l in &used {
         let name = mesh.label_names[l as usize].replace('"', "'");
         let _ = writeln!(s, "2 {} \"{}\"", l + 1, name);
@@ -28,7 +34,21 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let _ = writeln!(s, "$EndPhysicalNames");
     let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(mesh, p)).collect();
     let (lo, hi) = bounds(&mapped);
-    let _ = writeln!(s, "$Entities\n0 0 {} 0", used.len());
+    let _ = writeln!(s, "$Entities\n0 {} {} 0", curves.len(), used.len());
+    for (i, b) in curves.iter().enumerate() {
+        let ends: Vec<[f64; 2]> = b.vertices().iter().map(|&v| mapped[v as usize]).collect();
+        let (clo, chi) = bounds(&ends);
+        let _ = writeln!(
+            s,
+            "{} {} {} 0 {} {} 0 1 {} 0",
+            i + 1,
+            clo[0],
+            clo[1],
+            chi[0],
+            chi[1],
+            i + 1
+        );
+    }
     for &l in &used {
         let _ = writeln!(
             s,
@@ -64,8 +84,9 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             }
         }
     }
-    let m = mesh.elements.len();
-    let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len());
+    let lines: usize = curves.iter().map(|b| b.edges.len()).sum();
+    let m = mesh.elements.len() + lines;
+    let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len() + curves.len());
     let mut tag = 1usize;
     for (l, kind, members) in &blocks {
         let _ = writeln!(s, "2 {} {kind} {}", l + 1, members.len());
@@ -75,6 +96,14 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
                 let _ = write!(s, " {}", v + 1);
             }
             s.push('\n');
+            tag += 1;
+        }
+    }
+    // Boundary edges as 2-node lines (type 1) on their curve entities.
+    for (i, b) in curves.iter().enumerate() {
+        let _ = writeln!(s, "1 {} 1 {}", i + 1, b.edges.len());
+        for e in &b.edges {
+            let _ = writeln!(s, "{tag} {} {}", e[0] + 1, e[1] + 1);
             tag += 1;
         }
     }

@@ -91,16 +91,26 @@ pub fn write_vtu(
     cell_data: &[(String, Vec<f64>)],
 ) -> Result<(), WriteError> {
     check(path, mesh)?;
-    if let Some((name, _)) = cell_data
+    check_cell_data(path, mesh, cell_data)?;
+    write_atomic(path, vtu_string(mesh, frame, cell_data).as_bytes())
+}
+
+/// Refuses cell data without exactly one value per element.
+pub(crate) fn check_cell_data(
+    path: &Path,
+    mesh: &SegmentedMeshData,
+    cell_data: &[(String, Vec<f64>)],
+) -> Result<(), WriteError> {
+    match cell_data
         .iter()
         .find(|(_, v)| v.len() != mesh.elements.len())
     {
-        return Err(WriteError::Invalid {
+        Some((name, _)) => Err(WriteError::Invalid {
             path: path.to_path_buf(),
             reason: format!("cell data {name} does not have one value per element"),
-        });
+        }),
+        None => Ok(()),
     }
-    write_atomic(path, vtu_string(mesh, frame, cell_data).as_bytes())
 }
 
 pub(crate) fn xml_escape(s: &str) -> String {

@@ -1,6 +1,9 @@
 //! The writers: y-up counter-clockwise output, exact areas, atomic failure.
 
-use imesh_io::{msh_string, vtu_string, write_msh, written_corners, Frame, SegmentedMeshData};
+use imesh_io::{
+    boundaries, inp_string, msh_string, vtk_string, vtu_string, write_msh, written_corners, Frame,
+    SegmentedMeshData, OUTSIDE,
+};
 use imesh_quality::Element;
 use proptest::prelude::*;
 
@@ -65,10 +68,14 @@ fn parse_msh(text: &str) -> (Vec<[f64; 2]>, Vec<Vec<usize>>, Vec<String>) {
     let mut elements = Vec::new();
     let mut k = i + 2;
     while lines[k] != "$EndElements" {
-        let count: usize = lines[k].split(' ').nth(3).unwrap().parse().unwrap();
-        for l in &lines[k + 1..k + 1 + count] {
-            let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
-            elements.push(v);
+        let head: Vec<usize> = lines[k].split(' ').map(|x| x.parse().unwrap()).collect();
+        let count = head[3];
+        // Surface blocks only (dimension 2); boundary lines are checked separately.
+        if head[0] == 2 {
+            for l in &lines[k + 1..k + 1 + count] {
+                let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
+                elements.push(v);
+            }
         }
         k += 1 + count;
     }
@@ -93,7 +100,11 @@ proptest! {
         let (nodes, elements, names) = parse_msh(&msh_string(&mesh, &frame));
         prop_assert_eq!(nodes.len(), mesh.vertices.len());
         prop_assert_eq!(elements.len(), mesh.elements.len());
-        prop_assert_eq!(names.len(), if w > 1 { 2 } else { 1 });
+        // Surfaces: one per label used; curves: a border per label, and even|odd when both exist.
+        let surfaces = names.iter().filter(|n| n.starts_with("2 ")).count();
+        let curves = names.iter().filter(|n| n.starts_with("1 ")).count();
+        prop_assert_eq!(surfaces, if w > 1 { 2 } else { 1 });
+        prop_assert_eq!(curves, if w > 1 { 3 } else { 1 });
         let mut total = 0.0;
         for e in &elements {
             let p: Vec<[f64; 2]> = e.iter().map(|&v| nodes[v - 1]).collect();
@@ -149,4 +160,39 @@ fn a_failed_write_leaves_no_file_and_says_why() {
         0,
         "a temporary file was left"
     );
+}
+
+#[test]
+fn boundaries_separate_labels_and_the_border() {
+    // 4 × 2 squares, labels by column parity: three inner boundaries even|odd, and the border.
+    let mesh = grid_mesh(4, 2);
+    let b = boundaries(&mesh);
+    let labels: Vec<[u32; 2]> = b.iter().map(|b| b.labels).collect();
+    assert_eq!(labels, vec![[0, 1], [0, OUTSIDE], [1, OUTSIDE]]);
+    assert_eq!(b[0].edges.len(), 3 * 2, "three vertical lines of two edges");
+    let border: usize = b[1].edges.len() + b[2].edges.len();
+    assert_eq!(border, 2 * (4 + 2));
+    assert_eq!(b[1].name(&mesh), "border_even");
+    assert_eq!(b[0].name(&mesh), "even_odd");
+}
+
+#[test]
+fn abaqus_has_element_sets_per_label_and_node_sets_per_boundary() {
+    let mesh = grid_mesh(2, 1);
+    let text = inp_string(&mesh, &Frame::default());
+    assert!(text.contains("*Element, type=CPS3, elset=even"));
+    assert!(text.contains("*Element, type=CPS3, elset=odd"));
+    assert!(text.contains("*Nset, nset=even_odd\n2, 5\n"));
+    assert!(text.contains("*Nset, nset=border_even"));
+}
+
+#[test]
+fn legacy_vtk_counts_and_labels() {
+    let mesh = grid_mesh(3, 2);
+    let text = vtk_string(&mesh, &Frame::default(), &[("shape".into(), vec![1.0; 12])]);
+    assert!(text.starts_with("# vtk DataFile Version 3.0\n"));
+    assert!(text.contains("POINTS 12 double"));
+    assert!(text.contains("CELLS 12 48"));
+    assert!(text.contains("SCALARS label int 1"));
+    assert!(text.contains("SCALARS shape double 1"));
 }

@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use imesh::{Elements, MeshOptions, Pipeline, PipelineResult};
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
-use imesh_io::{write_atomic, write_msh, write_svg, write_vtu, Frame, SvgOptions};
+use imesh_io::{
+    write_atomic, write_inp, write_msh, write_svg, write_vtk, write_vtu, Frame, SvgOptions,
+};
 
 #[derive(Parser)]
 #[command(
@@ -38,7 +40,8 @@ enum Command {
 struct MeshArgs {
     /// The image (PNG, JPEG, TIFF, BMP, ...).
     image: PathBuf,
-    /// Output mesh: .msh (Gmsh 4.1) or .vtu (VTK XML). Default: IMAGE's name with .msh, here.
+    /// Output mesh: .msh (Gmsh 4.1), .vtu (VTK XML), .vtk (legacy VTK) or .inp (Abaqus).
+    /// Default: IMAGE's name with .msh, in the current directory.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Options from a TOML file (command-line options override it).
@@ -175,9 +178,9 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if !matches!(format.as_str(), "msh" | "vtu") {
+    if !matches!(format.as_str(), "msh" | "vtu" | "vtk" | "inp") {
         return Err(format!(
-            "cannot write {}: use an output ending in .msh (Gmsh) or .vtu (VTK XML)",
+            "cannot write {}: use an output ending in .msh (Gmsh), .vtu (VTK XML), .vtk (legacy VTK) or .inp (Abaqus)",
             output.display()
         ));
     }
@@ -188,20 +191,22 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         .run_path(&args.image)
         .map_err(|e| e.to_string())?;
     let io = |e: imesh_io::WriteError| e.to_string();
+    let cell_data = || {
+        let shape: Vec<f64> = mesh
+            .elements
+            .iter()
+            .map(|e| {
+                let c = e.corners();
+                imesh_quality::tri::shape(&[c[0], c[1], c[2]].map(|v| mesh.vertices[v as usize]))
+            })
+            .collect();
+        vec![("shape".to_string(), shape)]
+    };
     match format.as_str() {
         "msh" => write_msh(&output, &mesh, &frame).map_err(io)?,
-        _ => {
-            let quality = imesh_quality::tri::shape;
-            let shape: Vec<f64> = mesh
-                .elements
-                .iter()
-                .map(|e| {
-                    let c = e.corners();
-                    quality(&[c[0], c[1], c[2]].map(|v| mesh.vertices[v as usize]))
-                })
-                .collect();
-            write_vtu(&output, &mesh, &frame, &[("shape".into(), shape)]).map_err(io)?;
-        }
+        "inp" => write_inp(&output, &mesh, &frame).map_err(io)?,
+        "vtk" => write_vtk(&output, &mesh, &frame, &cell_data()).map_err(io)?,
+        _ => write_vtu(&output, &mesh, &frame, &cell_data()).map_err(io)?,
     }
     if let Some(svg) = &args.svg {
         write_svg(svg, &mesh, &SvgOptions::default()).map_err(io)?;

@@ -17,21 +17,38 @@ fn imesh(args: &[&str], dir: &Path) -> Output {
         .expect("the imesh binary runs")
 }
 
-/// The counts of an MSH 4.1 file: nodes, elements, physical names.
-fn msh_counts(text: &str) -> (usize, usize, usize) {
+/// The counts of an MSH 4.1 file: nodes, surface elements, physical surfaces, physical curves.
+fn msh_counts(text: &str) -> (usize, usize, usize, usize) {
     let lines: Vec<&str> = text.lines().collect();
-    let after = |tag: &str| {
-        let i = lines
+    let at = |tag: &str| {
+        lines
             .iter()
             .position(|l| *l == tag)
-            .expect("section present");
-        lines[i + 1]
+            .expect("section present")
     };
     let field = |line: &str, k: usize| line.split(' ').nth(k).unwrap().parse::<usize>().unwrap();
+    let names = at("$PhysicalNames");
+    let n_names: usize = lines[names + 1].parse().unwrap();
+    let named = |dim: &str| {
+        lines[names + 2..names + 2 + n_names]
+            .iter()
+            .filter(|l| l.starts_with(dim))
+            .count()
+    };
+    let mut surface_elements = 0;
+    let mut k = at("$Elements") + 2;
+    while lines[k] != "$EndElements" {
+        let count = field(lines[k], 3);
+        if field(lines[k], 0) == 2 {
+            surface_elements += count;
+        }
+        k += 1 + count;
+    }
     (
-        field(after("$Nodes"), 1),
-        field(after("$Elements"), 1),
-        after("$PhysicalNames").parse().unwrap(),
+        field(lines[at("$Nodes") + 1], 1),
+        surface_elements,
+        named("2 "),
+        named("1 "),
     )
 }
 
@@ -59,7 +76,7 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     let msh = std::fs::read_to_string(dir.path().join("pyvista-channels_z050_labels.msh")).unwrap();
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("m.json")).unwrap()).unwrap();
-    let (nodes, elements, names) = msh_counts(&msh);
+    let (nodes, elements, names, curves) = msh_counts(&msh);
     assert_eq!(nodes as u64, report["counts"]["vertices"].as_u64().unwrap());
     assert_eq!(
         elements as u64,
@@ -68,6 +85,10 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     assert_eq!(
         names, 5,
         "one physical surface per label of the 5-label map"
+    );
+    assert!(
+        curves >= 5,
+        "a physical curve per boundary, each label's border among them"
     );
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
@@ -105,6 +126,32 @@ fn vtu_output_and_options() {
     assert!(out.stdout.is_empty(), "--quiet prints nothing");
     let vtu = std::fs::read_to_string(dir.path().join("coins.vtu")).unwrap();
     assert!(vtu.contains("Name=\"label\"") && vtu.contains("Name=\"shape\""));
+}
+
+#[test]
+fn abaqus_and_legacy_vtk_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("pyvista-channels_z050_labels.png");
+    for name in ["m.inp", "m.vtk"] {
+        let out = imesh(
+            &["mesh", image.to_str().unwrap(), "-o", name, "-q"],
+            dir.path(),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let inp = std::fs::read_to_string(dir.path().join("m.inp")).unwrap();
+    assert_eq!(
+        inp.matches("*Element, type=CPS3").count(),
+        5,
+        "an element set per label"
+    );
+    assert!(inp.contains("*Nset, nset=border_"));
+    let vtk = std::fs::read_to_string(dir.path().join("m.vtk")).unwrap();
+    assert!(vtk.contains("SCALARS label int 1") && vtk.contains("SCALARS shape double 1"));
 }
 
 #[test]

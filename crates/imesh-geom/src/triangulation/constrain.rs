@@ -587,7 +587,7 @@ impl Triangulation {
     /// let pts = [Point::new(0.0, 0.0), Point::new(2.0, 0.0), Point::new(2.0, 2.0), Point::new(0.0, 2.0), Point::new(1.0, 1.0)];
     /// let (t, v) = Triangulation::from_points(&pts).unwrap();
     /// assert_eq!(t.vertex_triangles(v[4]).count(), 4);
-    /// assert_eq!(t.vertex_triangles(v[0]).count(), 1);
+    /// assert_eq!(t.vertex_triangles(v[0]).count(), 2); // a corner: two of the four triangles
     /// ```
     pub fn vertex_triangles(&self, v: VertexId) -> impl Iterator<Item = TriangleId> + '_ {
         self.star(v.0)

@@ -9,11 +9,18 @@ cells = {}
 for block in mesh.cells:
     cells[block.type] = cells.get(block.type, 0) + int(len(block.data))
 labels = sorted({int(v) for block in mesh.cell_data.get("label", []) for v in block})
-physical = sorted({int(v) for block in mesh.cell_data.get("gmsh:physical", []) for v in block})
+physical = sorted({
+    int(v)
+    for block, tags in zip(mesh.cells, mesh.cell_data.get("gmsh:physical", []))
+    if block.type in ("triangle", "quad")
+    for v in tags
+})
 # Signed areas in the file's frame: every element must be counter-clockwise.
 negative = 0
 area = 0.0
 for block in mesh.cells:
+    if block.type not in ("triangle", "quad"):
+        continue
     for cell in block.data:
         p = mesh.points[cell][:, :2]
         a = 0.5 * sum(p[i - 1][0] * p[i][1] - p[i][0] * p[i - 1][1] for i in range(len(p)))
