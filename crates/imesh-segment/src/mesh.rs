@@ -70,7 +70,7 @@ impl SegmentedMesh {
     }
 
     /// Imesh's triangle output: Ruppert refinement to `options.min_angle_deg` that keeps every
-    /// circumcentre inside the region of its triangle (a circumcentre beyond a c-edge splits that
+    /// inserted point inside the region of its triangle (a point beyond a c-edge splits that
     /// c-edge instead). Labels follow every insertion. The c-edge list is not updated: its edges
     /// may now be split into several pieces ([`Triangulation::segment_vertices`] lists them).
     ///
