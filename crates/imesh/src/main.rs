@@ -6,9 +6,11 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use imesh::{Elements, MeshOptions, Pipeline, PipelineResult};
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
+use imesh_io::SegmentedMeshData;
 use imesh_io::{
     write_atomic, write_inp, write_msh, write_svg, write_vtk, write_vtu, Frame, SvgOptions,
 };
+use rayon::prelude::*;
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +36,9 @@ enum Command {
         after_help = "Example:\n  imesh classify fixtures/images/skimage-coffee.png --classify kmeans:4 -o coffee-labels.png"
     )]
     Classify(ClassifyArgs),
+    /// Mesh every image of a folder, in parallel; one failure does not stop the others.
+    #[command(after_help = "Example:\n  imesh batch fixtures/images -o meshes --format vtu")]
+    Batch(BatchArgs),
 }
 
 #[derive(Args)]
@@ -44,6 +49,36 @@ struct MeshArgs {
     /// Default: IMAGE's name with .msh, in the current directory.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    flags: MeshFlags,
+    /// Also draw the mesh as SVG.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Also write the JSON report (counts, per-stage seconds, quality, label agreement).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+struct BatchArgs {
+    /// The folder of images (PNG, JPEG, TIFF, BMP, PNM files in it; not its subfolders).
+    dir: PathBuf,
+    /// The folder for the meshes and their JSON reports (created if missing).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Mesh format: msh, vtu, vtk or inp.
+    #[arg(long, default_value = "msh")]
+    format: String,
+    #[command(flatten)]
+    flags: MeshFlags,
+}
+
+/// The mesh options `mesh` and `batch` share.
+#[derive(Args)]
+struct MeshFlags {
     /// Options from a TOML file (command-line options override it).
     #[arg(long)]
     config: Option<PathBuf>,
@@ -68,15 +103,6 @@ struct MeshArgs {
     /// Physical size of a pixel: SX or SX,SY.
     #[arg(long, value_parser = parse_pixel_size)]
     pixel_size: Option<[f64; 2]>,
-    /// Also draw the mesh as SVG.
-    #[arg(long)]
-    svg: Option<PathBuf>,
-    /// Also write the JSON report (counts, per-stage seconds, quality, label agreement).
-    #[arg(long)]
-    report: Option<PathBuf>,
-    /// Print nothing but errors.
-    #[arg(short, long)]
-    quiet: bool,
 }
 
 #[derive(Args)]
@@ -113,6 +139,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Mesh(args) => mesh(&args),
         Command::Classify(args) => classify_command(&args),
+        Command::Batch(args) => batch(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -123,7 +150,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn options(args: &MeshArgs) -> Result<MeshOptions, String> {
+fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     let mut o = match &args.config {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -161,35 +188,33 @@ fn toml_options(text: &str) -> Result<MeshOptions, String> {
     toml::from_str(text).map_err(|e| e.to_string())
 }
 
-fn mesh(args: &MeshArgs) -> Result<(), String> {
-    let options = options(args)?;
-    let output = match &args.output {
-        Some(p) => p.clone(),
-        None => {
-            let stem = args
-                .image
-                .file_stem()
-                .ok_or_else(|| format!("{} has no file name", args.image.display()))?;
-            PathBuf::from(stem).with_extension("msh")
-        }
-    };
+/// The mesh formats, by file extension.
+const FORMATS: [&str; 4] = ["msh", "vtu", "vtk", "inp"];
+
+fn format_of(output: &Path) -> Result<String, String> {
     let format = output
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if !matches!(format.as_str(), "msh" | "vtu" | "vtk" | "inp") {
-        return Err(format!(
+    if FORMATS.contains(&format.as_str()) {
+        Ok(format)
+    } else {
+        Err(format!(
             "cannot write {}: use an output ending in .msh (Gmsh), .vtu (VTK XML), .vtk (legacy VTK) or .inp (Abaqus)",
             output.display()
-        ));
+        ))
     }
-    let frame = Frame {
-        pixel_size: options.pixel_size,
-    };
-    let PipelineResult { mesh, report } = Pipeline::new(options)
-        .run_path(&args.image)
-        .map_err(|e| e.to_string())?;
+}
+
+/// Writes the mesh in the format its name says, with the triangles' shape as cell data where the
+/// format holds it.
+fn write_mesh(
+    output: &Path,
+    format: &str,
+    mesh: &SegmentedMeshData,
+    frame: &Frame,
+) -> Result<(), String> {
     let io = |e: imesh_io::WriteError| e.to_string();
     let cell_data = || {
         let shape: Vec<f64> = mesh
@@ -202,18 +227,44 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             .collect();
         vec![("shape".to_string(), shape)]
     };
-    match format.as_str() {
-        "msh" => write_msh(&output, &mesh, &frame).map_err(io)?,
-        "inp" => write_inp(&output, &mesh, &frame).map_err(io)?,
-        "vtk" => write_vtk(&output, &mesh, &frame, &cell_data()).map_err(io)?,
-        _ => write_vtu(&output, &mesh, &frame, &cell_data()).map_err(io)?,
+    match format {
+        "msh" => write_msh(output, mesh, frame).map_err(io),
+        "inp" => write_inp(output, mesh, frame).map_err(io),
+        "vtk" => write_vtk(output, mesh, frame, &cell_data()).map_err(io),
+        _ => write_vtu(output, mesh, frame, &cell_data()).map_err(io),
     }
+}
+
+fn write_report(path: &Path, report: &imesh::Report) -> Result<(), String> {
+    let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
+    write_atomic(path, json.as_bytes()).map_err(|e| e.to_string())
+}
+
+fn mesh(args: &MeshArgs) -> Result<(), String> {
+    let options = options(&args.flags)?;
+    let output = match &args.output {
+        Some(p) => p.clone(),
+        None => {
+            let stem = args
+                .image
+                .file_stem()
+                .ok_or_else(|| format!("{} has no file name", args.image.display()))?;
+            PathBuf::from(stem).with_extension("msh")
+        }
+    };
+    let format = format_of(&output)?;
+    let frame = Frame {
+        pixel_size: options.pixel_size,
+    };
+    let PipelineResult { mesh, report } = Pipeline::new(options)
+        .run_path(&args.image)
+        .map_err(|e| e.to_string())?;
+    write_mesh(&output, &format, &mesh, &frame)?;
     if let Some(svg) = &args.svg {
-        write_svg(svg, &mesh, &SvgOptions::default()).map_err(io)?;
+        write_svg(svg, &mesh, &SvgOptions::default()).map_err(|e| e.to_string())?;
     }
     if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
-        write_atomic(path, json.as_bytes()).map_err(io)?;
+        write_report(path, &report)?;
     }
     if !args.quiet {
         let c = &report.counts;
@@ -237,6 +288,103 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             q.shape.min,
             q.shape.mean
         );
+    }
+    Ok(())
+}
+
+/// Image files of a folder, sorted by name.
+fn images_in(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    const IMAGES: [&str; 10] = [
+        "png", "jpg", "jpeg", "tif", "tiff", "bmp", "pnm", "pgm", "ppm", "pbm",
+    ];
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot read the folder {}: {e}", dir.display()))?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| {
+            p.is_file()
+                && p.extension()
+                    .and_then(|e| e.to_str())
+                    .is_some_and(|e| IMAGES.contains(&e.to_ascii_lowercase().as_str()))
+        })
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn batch(args: &BatchArgs) -> Result<(), String> {
+    let options = options(&args.flags)?;
+    let format = args.format.to_ascii_lowercase();
+    if !FORMATS.contains(&format.as_str()) {
+        return Err(format!(
+            "unknown format {:?}: use msh, vtu, vtk or inp",
+            args.format
+        ));
+    }
+    let images = images_in(&args.dir)?;
+    if images.is_empty() {
+        return Err(format!(
+            "no images (png, jpg, tif, bmp, pnm) in {}",
+            args.dir.display()
+        ));
+    }
+    std::fs::create_dir_all(&args.output)
+        .map_err(|e| format!("cannot create the folder {}: {e}", args.output.display()))?;
+    let frame = Frame {
+        pixel_size: options.pixel_size,
+    };
+    let pipeline = Pipeline::new(options);
+    // One image per task; each image's stages use the same pool for their own parallel work.
+    let results: Vec<Result<imesh::Report, String>> = images
+        .par_iter()
+        .map(|image| {
+            let stem = image
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let PipelineResult { mesh, report } =
+                pipeline.run_path(image).map_err(|e| e.to_string())?;
+            let output = args.output.join(&stem).with_extension(&format);
+            write_mesh(&output, &format, &mesh, &frame)?;
+            write_report(&args.output.join(format!("{stem}.json")), &report)?;
+            Ok(report)
+        })
+        .collect();
+    println!(
+        "{:<40} {:>8} {:>9} {:>10} {:>8}  {}",
+        "image", "labels", "vertices", "elements", "seconds", "label agreement / error"
+    );
+    let mut failed = 0;
+    for (image, result) in images.iter().zip(&results) {
+        let name = image
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        match result {
+            Ok(r) => println!(
+                "{:<40} {:>8} {:>9} {:>10} {:>8.3}  {:.2} %",
+                name,
+                r.counts.labels,
+                r.counts.vertices,
+                r.counts.elements,
+                r.seconds.total,
+                100.0 * r.label_agreement
+            ),
+            Err(e) => {
+                failed += 1;
+                println!(
+                    "{name:<40} {:>8} {:>9} {:>10} {:>8}  FAILED: {e}",
+                    "-", "-", "-", "-"
+                );
+            }
+        }
+    }
+    if failed > 0 {
+        return Err(format!(
+            "{failed} of {} images failed (see the table)",
+            images.len()
+        ));
     }
     Ok(())
 }

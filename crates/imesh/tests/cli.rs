@@ -245,3 +245,44 @@ fn classify_writes_a_label_image() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("3 labels"));
     assert!(dir.path().join("labels.png").exists());
 }
+
+#[test]
+fn batch_meshes_a_folder_and_reports_failures_without_stopping() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    for name in [
+        "matplotlib-s1045_mri.png",
+        "pyvista-channels_z050_labels.png",
+    ] {
+        std::fs::copy(fixture(name), input.join(name)).unwrap();
+    }
+    std::fs::write(input.join("broken.png"), b"not an image").unwrap();
+    std::fs::write(
+        input.join("readme.txt"),
+        b"not an image, and not a .png either",
+    )
+    .unwrap();
+    let out = imesh(&["batch", "in", "-o", "out", "--format", "vtu"], dir.path());
+    assert_eq!(out.status.code(), Some(2), "one image failed");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("broken.png") && table.contains("FAILED"),
+        "{table}"
+    );
+    assert_eq!(table.matches("FAILED").count(), 1, "{table}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 of 3 images failed"));
+    for stem in ["matplotlib-s1045_mri", "pyvista-channels_z050_labels"] {
+        assert!(dir.path().join("out").join(format!("{stem}.vtu")).exists());
+        assert!(dir.path().join("out").join(format!("{stem}.json")).exists());
+    }
+    // All good: exit code 0.
+    std::fs::remove_file(input.join("broken.png")).unwrap();
+    let out = imesh(&["batch", "in", "-o", "out2"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("out2/matplotlib-s1045_mri.msh").exists());
+}
