@@ -352,8 +352,8 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
         })
         .collect();
     println!(
-        "{:<40} {:>8} {:>9} {:>10} {:>8}  {}",
-        "image", "labels", "vertices", "elements", "seconds", "label agreement / error"
+        "{:<40} {:>8} {:>9} {:>10} {:>8}  label agreement / error",
+        "image", "labels", "vertices", "elements", "seconds"
     );
     let mut failed = 0;
     for (image, result) in images.iter().zip(&results) {
