@@ -1,6 +1,6 @@
 //! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label and a
 //! physical curve per boundary), VTK XML `.vtu` and legacy `.vtk` (cell data: label and quality),
-//! Abaqus `.inp` (an element set per label, a node set per boundary) and SVG pictures. Every file is written atomically (a temporary
+//! Abaqus `.inp` (an element set per label, a node set per boundary), and SVG and PNG pictures. Every file is written atomically (a temporary
 //! file in the same directory, renamed into place), so a failed run never leaves half a file.
 //!
 //! Meshes come in image coordinates (y down, elements counter-clockwise there); writers emit the
@@ -29,6 +29,7 @@
 mod boundary;
 mod inp;
 mod msh;
+mod png;
 mod svg;
 mod vtk;
 mod vtu;
@@ -41,6 +42,7 @@ use imesh_quality::Element;
 pub use boundary::{boundaries, sanitize, Boundary, OUTSIDE};
 pub use inp::{inp_string, write_inp};
 pub use msh::{msh_string, write_msh};
+pub use png::{rasterise, write_png};
 pub use svg::{svg_string, write_svg, SvgOptions};
 pub use vtk::{vtk_string, write_vtk};
 pub use vtu::{vtu_string, write_vtu};

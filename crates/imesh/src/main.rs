@@ -8,7 +8,8 @@ use imesh::{Elements, MeshOptions, Pipeline, PipelineResult};
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
-    write_atomic, write_inp, write_msh, write_svg, write_vtk, write_vtu, Frame, SvgOptions,
+    write_atomic, write_inp, write_msh, write_png, write_svg, write_vtk, write_vtu, Frame,
+    SvgOptions,
 };
 use rayon::prelude::*;
 
@@ -54,6 +55,9 @@ struct MeshArgs {
     /// Also draw the mesh as SVG.
     #[arg(long)]
     svg: Option<PathBuf>,
+    /// Also draw the mesh as PNG.
+    #[arg(long)]
+    png: Option<PathBuf>,
     /// Also write the JSON report (counts, per-stage seconds, quality, label agreement).
     #[arg(long)]
     report: Option<PathBuf>,
@@ -262,6 +266,9 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     write_mesh(&output, &format, &mesh, &frame)?;
     if let Some(svg) = &args.svg {
         write_svg(svg, &mesh, &SvgOptions::default()).map_err(|e| e.to_string())?;
+    }
+    if let Some(png) = &args.png {
+        write_png(png, &mesh).map_err(|e| e.to_string())?;
     }
     if let Some(path) = &args.report {
         write_report(path, &report)?;

@@ -64,6 +64,8 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
             "m.svg",
             "--report",
             "m.json",
+            "--png",
+            "m.png",
         ],
         dir.path(),
     );
@@ -93,6 +95,8 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
     assert!(report["label_agreement"].as_f64().unwrap() > 0.97);
+    let png = std::fs::read(dir.path().join("m.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "a PNG picture");
     assert!(std::fs::read_to_string(dir.path().join("m.svg"))
         .unwrap()
         .contains("<polygon"));
