@@ -576,29 +576,13 @@ impl Triangulation {
     /// `v` without end: it is not split.
     fn shell_split(&self, h: u32, v: u32, shells: &Shells) -> ShellSplit {
         let (u, w) = (self.origin[h as usize], self.origin[next(h) as usize]);
-        let (Some([a0, a1]), Some([b0, b1])) = (
-            Some(self.piece_ends(u, w, shells)),
-            self.sub_segment(v, shells),
-        ) else {
+        let Some(sv) = self.sub_segment(v, shells) else {
             return ShellSplit::Usual;
         };
-        if [a0, a1] == [b0, b1] || [a0, a1] == [b1, b0] {
-            return ShellSplit::Usual;
-        }
-        let apex = if a0 == b0 || a0 == b1 {
-            a0
-        } else if a1 == b0 || a1 == b1 {
-            a1
-        } else {
+        let Some((apex, _, _)) = common_end(self.piece_ends(u, w, shells), sv) else {
             return ShellSplit::Usual;
         };
-        let [pa, pu, pw, pv] = [
-            apex,
-            self.origin[h as usize],
-            self.origin[next(h) as usize],
-            v,
-        ]
-        .map(|x| self.points[x as usize]);
+        let [pa, pu, pw, pv] = [apex, u, w, v].map(|x| self.points[x as usize]);
         let (du, dw, r) = (
             pa.distance_squared(pu).sqrt(),
             pa.distance_squared(pw).sqrt(),
@@ -664,19 +648,11 @@ impl Triangulation {
             self.origin[opposite as usize],
             self.origin[next(opposite) as usize],
         );
-        let (Some([a0, a1]), Some([b0, b1])) =
-            (self.sub_segment(u, shells), self.sub_segment(w, shells))
+        let (Some(su), Some(sw)) = (self.sub_segment(u, shells), self.sub_segment(w, shells))
         else {
             return false;
         };
-        if [a0, a1] == [b0, b1] || [a0, a1] == [b1, b0] {
-            return false;
-        }
-        let (apex, eu, ew) = if a0 == b0 || a0 == b1 {
-            (a0, a1, if a0 == b0 { b1 } else { b0 })
-        } else if a1 == b0 || a1 == b1 {
-            (a1, a0, if a1 == b0 { b1 } else { b0 })
-        } else {
+        let Some((apex, eu, ew)) = common_end(su, sw) else {
             return false;
         };
         let [pa, pu, pw] = [apex, u, w].map(|v| self.points[v as usize]);
@@ -714,13 +690,8 @@ impl Triangulation {
         let mut k = 0;
         for first in self.star(v).filter(|&h| self.segment[h as usize] == s) {
             let (mut from, mut at) = (v, self.origin[next(first) as usize]);
-            while at != GHOST && at >= shells.n_input && k < 2 {
-                let Some(step) = self
-                    .star(at)
-                    .filter(|&h| self.segment[h as usize] == s)
-                    .map(|h| self.origin[next(h) as usize])
-                    .find(|&x| x != from)
-                else {
+            while at != GHOST && at >= shells.n_input {
+                let Some(step) = self.next_on_segment(s, at, from) else {
                     break;
                 };
                 (from, at) = (at, step);
@@ -791,6 +762,21 @@ impl Triangulation {
     /// The two end vertices of half-edge `h`.
     fn edge_ends(&self, h: u32) -> [u32; 2] {
         [self.origin[h as usize], self.origin[next(h) as usize]]
+    }
+}
+
+/// The end two different sub-segments share, with the far end of each: `(apex, far a, far b)`.
+fn common_end([a0, a1]: [u32; 2], [b0, b1]: [u32; 2]) -> Option<(u32, u32, u32)> {
+    if [a0, a1] == [b0, b1] || [a0, a1] == [b1, b0] {
+        return None;
+    }
+    let other_b = |x: u32| if x == b0 { b1 } else { b0 };
+    if a0 == b0 || a0 == b1 {
+        Some((a0, a1, other_b(a0)))
+    } else if a1 == b0 || a1 == b1 {
+        Some((a1, a0, other_b(a1)))
+    } else {
+        None
     }
 }
 

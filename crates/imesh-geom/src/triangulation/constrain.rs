@@ -76,18 +76,22 @@ impl Triangulation {
         let mut out = vec![VertexId(a)];
         let (mut v, mut from) = (a, NONE);
         while v != b && out.len() <= self.points.len() {
-            let Some(w) = self
-                .star(v)
-                .filter(|&h| self.segment[h as usize] == s.0)
-                .map(|h| self.origin[next(h) as usize])
-                .find(|&w| w != from && w != GHOST)
-            else {
+            let Some(w) = self.next_on_segment(s.0, v, from) else {
                 break;
             };
             out.push(VertexId(w));
             (from, v) = (v, w);
         }
         out
+    }
+
+    /// The neighbour of `v` along segment `s` other than `from`: the far end of the segment's
+    /// other piece at `v`, if any.
+    pub(crate) fn next_on_segment(&self, s: u32, v: u32, from: u32) -> Option<u32> {
+        self.star(v)
+            .filter(|&h| self.segment[h as usize] == s)
+            .map(|h| self.origin[next(h) as usize])
+            .find(|&w| w != from && w != GHOST)
     }
 
     /// Number of input segments.
