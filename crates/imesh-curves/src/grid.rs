@@ -1,0 +1,226 @@
+//! A uniform grid over the graph's bounding box: the spatial index that keeps the
+//! topology checks of simplification local (edges and vertices near a shortcut only).
+
+use imesh_geom::predicates::orient2d;
+use imesh_geom::Point;
+
+use crate::graph::CurveGraph;
+
+/// Cells of side `h` over a bounding box; cell `(cx, cy)` has index `cy * nx + cx`.
+#[derive(Clone, Debug)]
+pub(crate) struct Grid {
+    origin: Point,
+    h: f64,
+    nx: usize,
+    ny: usize,
+}
+
+impl Grid {
+    /// A grid over the bounding box of `points` with about `cells` cells (at least one).
+    pub(crate) fn new(points: impl Iterator<Item = Point> + Clone, cells: usize) -> Self {
+        let (mut lo, mut hi) = (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        );
+        for p in points {
+            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        if lo.x > hi.x {
+            lo = Point::new(0.0, 0.0);
+            hi = lo;
+        }
+        let (w, hgt) = (
+            (hi.x - lo.x).max(f64::MIN_POSITIVE),
+            (hi.y - lo.y).max(f64::MIN_POSITIVE),
+        );
+        let cells = cells.clamp(1, 1 << 24) as f64;
+        let mut h = (w * hgt / cells).sqrt();
+        // A very thin box: cells along its long side only.
+        h = h.max(w.max(hgt) / cells).max(f64::MIN_POSITIVE);
+        let nx = ((w / h).floor() as usize + 1).min(1 << 24);
+        let ny = ((hgt / h).floor() as usize + 1).min(1 << 24);
+        Self {
+            origin: lo,
+            h,
+            nx,
+            ny,
+        }
+    }
+
+    /// The number of cells.
+    pub(crate) fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    fn column(&self, x: f64) -> usize {
+        (((x - self.origin.x) / self.h).floor().max(0.0) as usize).min(self.nx - 1)
+    }
+
+    fn row(&self, y: f64) -> usize {
+        (((y - self.origin.y) / self.h).floor().max(0.0) as usize).min(self.ny - 1)
+    }
+
+    /// The cell holding `p` (clamped to the grid).
+    pub(crate) fn cell(&self, p: Point) -> usize {
+        self.row(p.y) * self.nx + self.column(p.x)
+    }
+
+    /// Calls `f` on every cell that meets the segment `ab` grown by `pad` in x and y (a superset of
+    /// the cells within distance `pad` of it).
+    pub(crate) fn cells_near_segment(
+        &self,
+        a: Point,
+        b: Point,
+        pad: f64,
+        mut f: impl FnMut(usize),
+    ) {
+        let (left, right) = if a.x <= b.x { (a, b) } else { (b, a) };
+        let dx = right.x - left.x;
+        let c0 = self.column(left.x - pad);
+        let c1 = self.column(right.x + pad);
+        for cx in c0..=c1 {
+            let slab0 = self.origin.x + cx as f64 * self.h - pad;
+            let slab1 = slab0 + self.h + 2.0 * pad;
+            let (y0, y1) = if dx <= 0.0 {
+                (left.y.min(right.y), left.y.max(right.y))
+            } else {
+                let t0 = ((slab0 - left.x) / dx).clamp(0.0, 1.0);
+                let t1 = ((slab1 - left.x) / dx).clamp(0.0, 1.0);
+                let (ya, yb) = (
+                    left.y + t0 * (right.y - left.y),
+                    left.y + t1 * (right.y - left.y),
+                );
+                (ya.min(yb), ya.max(yb))
+            };
+            // The parameter arithmetic rounds: widen by a rounding margin on top of `pad`.
+            let margin = pad + 1e-9 * self.h;
+            for cy in self.row(y0 - margin)..=self.row(y1 + margin) {
+                f(cy * self.nx + cx);
+            }
+        }
+    }
+}
+
+/// True when the closed segments `ab` and `cd` meet anywhere except at one shared end vertex
+/// (vertex identity by index: `ends` are `[a, b]` and `[c, d]`). Sharing an end and running on
+/// along the same line (overlap) is a conflict; so is any touch between segments with no common
+/// end.
+pub(crate) fn conflict(points: &[Point], [a, b]: [u32; 2], [c, d]: [u32; 2]) -> bool {
+    let p = |v: u32| points[v as usize];
+    if (a == c && b == d) || (a == d && b == c) {
+        return true;
+    }
+    let shared = if a == c || a == d {
+        Some((a, b, if a == c { d } else { c }))
+    } else if b == c || b == d {
+        Some((b, a, if b == c { d } else { c }))
+    } else {
+        None
+    };
+    if let Some((x, z, y)) = shared {
+        // One common end x: only an overlap along one line conflicts.
+        let (px, pz, py) = (p(x), p(z), p(y));
+        if orient2d(px, pz, py) != 0.0 {
+            return false;
+        }
+        let same = |u: f64, v: f64| (u > 0.0 && v > 0.0) || (u < 0.0 && v < 0.0);
+        return same(pz.x - px.x, py.x - px.x) || same(pz.y - px.y, py.y - px.y);
+    }
+    let (pa, pb, pc, pd) = (p(a), p(b), p(c), p(d));
+    let o1 = orient2d(pa, pb, pc);
+    let o2 = orient2d(pa, pb, pd);
+    let o3 = orient2d(pc, pd, pa);
+    let o4 = orient2d(pc, pd, pb);
+    let opposite = |u: f64, v: f64| (u > 0.0 && v < 0.0) || (u < 0.0 && v > 0.0);
+    if opposite(o1, o2) && opposite(o3, o4) {
+        return true;
+    }
+    (o1 == 0.0 && within(pa, pb, pc))
+        || (o2 == 0.0 && within(pa, pb, pd))
+        || (o3 == 0.0 && within(pc, pd, pa))
+        || (o4 == 0.0 && within(pc, pd, pb))
+}
+
+/// For `q` collinear with `ab`: true when `q` lies on the closed segment.
+pub(crate) fn within(a: Point, b: Point, q: Point) -> bool {
+    q.x >= a.x.min(b.x) && q.x <= a.x.max(b.x) && q.y >= a.y.min(b.y) && q.y <= a.y.max(b.y)
+}
+
+/// Items per cell as singly linked lists in flat arrays: appending never allocates per cell,
+/// which matters with 10^5 cells and items added during simplification.
+#[derive(Clone, Debug)]
+pub(crate) struct CellLists {
+    head: Vec<u32>,
+    next: Vec<u32>,
+    item: Vec<u32>,
+}
+
+const END: u32 = u32::MAX;
+
+impl CellLists {
+    pub(crate) fn new(cells: usize, capacity: usize) -> Self {
+        Self {
+            head: vec![END; cells],
+            next: Vec::with_capacity(capacity),
+            item: Vec::with_capacity(capacity),
+        }
+    }
+
+    pub(crate) fn push(&mut self, cell: usize, item: u32) {
+        self.next.push(self.head[cell]);
+        self.item.push(item);
+        self.head[cell] = (self.item.len() - 1) as u32;
+    }
+
+    pub(crate) fn iter(&self, cell: usize) -> impl Iterator<Item = u32> + '_ {
+        let mut at = self.head[cell];
+        std::iter::from_fn(move || {
+            (at != END).then(|| {
+                let x = self.item[at as usize];
+                at = self.next[at as usize];
+                x
+            })
+        })
+    }
+}
+
+/// Registers each edge of `g` in the cells it meets.
+pub(crate) fn edge_cells(g: &CurveGraph, grid: &Grid) -> CellLists {
+    let mut cells = CellLists::new(grid.len(), 2 * g.edges().len());
+    for (i, e) in g.edges().iter().enumerate() {
+        grid.cells_near_segment(g.point(e.ends[0]), g.point(e.ends[1]), 0.0, |c| {
+            cells.push(c, i as u32);
+        });
+    }
+    cells
+}
+
+/// A grid with about one cell per four edges (cells a few edge lengths wide).
+pub(crate) fn grid_for(g: &CurveGraph) -> Grid {
+    let used = g.edges().iter().flat_map(|e| e.ends).map(|v| g.point(v));
+    Grid::new(used, g.edges().len() / 4)
+}
+
+/// The first pair of conflicting edges of `g`, if any.
+pub(crate) fn first_crossing(g: &CurveGraph) -> Option<[u32; 2]> {
+    let grid = grid_for(g);
+    let cells = edge_cells(g, &grid);
+    let mut list = Vec::new();
+    for c in 0..grid.len() {
+        list.clear();
+        list.extend(cells.iter(c));
+        for (k, &e) in list.iter().enumerate() {
+            for &f in &list[k + 1..] {
+                if conflict(
+                    g.points(),
+                    g.edges()[e as usize].ends,
+                    g.edges()[f as usize].ends,
+                ) {
+                    return Some([e.min(f), e.max(f)]);
+                }
+            }
+        }
+    }
+    None
+}

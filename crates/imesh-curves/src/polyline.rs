@@ -1,0 +1,183 @@
+//! Cutting the boundary graph into maximal simple open polylines (the paper's preprocessing for
+//! Douglas–Peucker, which only handles simple open curves).
+
+use crate::graph::{CurveGraph, GraphEdge};
+
+/// A simple open chain of graph vertices between two cut vertices.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Polyline {
+    /// Its vertices in order (at least two, all distinct).
+    pub vertices: Vec<u32>,
+    /// The graph edge between `vertices[i]` and `vertices[i + 1]`.
+    pub edges: Vec<u32>,
+    /// The label on the positive side of the chain walked from its first vertex, then the label on
+    /// the negative side (see [`GraphEdge::labels`]).
+    pub labels: [u32; 2],
+}
+
+impl Polyline {
+    /// The first and last vertex.
+    pub fn ends(&self) -> [u32; 2] {
+        [self.vertices[0], self.vertices[self.vertices.len() - 1]]
+    }
+}
+
+/// The maximal simple open polylines of `g`.
+///
+/// A polyline ends at every vertex whose valence is not 2, at every pinned vertex, and where the
+/// labels change (which a planar partition never does at a valence-2 vertex, but a caller's
+/// graph might). What is left are closed loops of valence-2 vertices: each is cut into three
+/// pieces of about equal length, starting at its lowest-then-leftmost vertex, so that no
+/// simplification can collapse it to a segment or a point.
+///
+/// Every edge of `g` is in exactly one polyline.
+///
+/// ```
+/// use imesh_curves::{polylines, CurveGraph, GraphEdge};
+/// use imesh_geom::Point;
+/// // A square loop: no vertex of valence ≠ 2, so it is cut into three pieces.
+/// let points = vec![
+///     Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(2.0, 0.0), Point::new(2.0, 2.0),
+///     Point::new(0.0, 2.0),
+/// ];
+/// let edges = (0..5u32).map(|i| GraphEdge { ends: [i, (i + 1) % 5], labels: [1, 0] }).collect();
+/// let g = CurveGraph::new(points, edges)?;
+/// let lines = polylines(&g);
+/// assert_eq!(lines.len(), 3);
+/// assert_eq!(lines.iter().map(|l| l.edges.len()).sum::<usize>(), 5);
+/// # Ok::<(), imesh_curves::CurveError>(())
+/// ```
+pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
+    let n = g.points().len() as u32;
+    let edges = g.edges();
+    let is_cut = |v: u32| {
+        let inc = g.incident(v);
+        if inc.len() != 2 || g.is_pinned(v) {
+            return true;
+        }
+        // Labels must continue through v: walking in along the first edge and out along the
+        // second keeps the same left and right.
+        let a = oriented(edges[inc[0] as usize], v, false);
+        let b = oriented(edges[inc[1] as usize], v, true);
+        a.labels != b.labels
+    };
+    let cut: Vec<bool> = (0..n).map(is_cut).collect();
+    let mut used = vec![false; edges.len()];
+    let mut lines = Vec::new();
+    for v in 0..n {
+        if !cut[v as usize] {
+            continue;
+        }
+        for &e in g.incident(v) {
+            if !used[e as usize] {
+                let line = walk(g, &cut, &mut used, v, e, None);
+                let [a, b] = line.ends();
+                if a == b {
+                    // A loop hanging off a cut vertex: cut it too, keeping that vertex an end.
+                    lines.extend(cut_loop(g, line, false));
+                } else {
+                    lines.push(line);
+                }
+            }
+        }
+    }
+    // Closed loops of valence-2 vertices remain.
+    for e in 0..edges.len() {
+        if used[e] {
+            continue;
+        }
+        let loop_line = walk(
+            g,
+            &cut,
+            &mut used,
+            edges[e].ends[0],
+            e as u32,
+            Some(edges[e].ends[0]),
+        );
+        lines.extend(cut_loop(g, loop_line, true));
+    }
+    lines
+}
+
+/// `e` walked so that `v` is its end (`leaving == false`) or its start (`leaving == true`).
+fn oriented(e: GraphEdge, v: u32, leaving: bool) -> GraphEdge {
+    if (e.ends[0] == v) == leaving {
+        e
+    } else {
+        e.reversed()
+    }
+}
+
+/// Walks from `start` along `first` until a cut vertex (or back to `stop`, for a loop).
+fn walk(
+    g: &CurveGraph,
+    cut: &[bool],
+    used: &mut [bool],
+    start: u32,
+    first: u32,
+    stop: Option<u32>,
+) -> Polyline {
+    let edges = g.edges();
+    let labels = oriented(edges[first as usize], start, true).labels;
+    let mut vertices = vec![start];
+    let mut line_edges = Vec::new();
+    let (mut v, mut e) = (start, first);
+    loop {
+        used[e as usize] = true;
+        line_edges.push(e);
+        let [a, b] = edges[e as usize].ends;
+        v = if a == v { b } else { a };
+        vertices.push(v);
+        if cut[v as usize] || Some(v) == stop {
+            break;
+        }
+        match g.incident(v).iter().find(|&&x| x != e) {
+            Some(&next) if !used[next as usize] => e = next,
+            _ => break,
+        }
+    }
+    Polyline {
+        vertices,
+        edges: line_edges,
+        labels,
+    }
+}
+
+/// Cuts a closed loop (first vertex repeated at the end) into three open pieces of about equal
+/// length, starting from its first vertex or (`reroot`) from its lowest-then-leftmost vertex.
+fn cut_loop(g: &CurveGraph, line: Polyline, reroot: bool) -> Vec<Polyline> {
+    let m = line.edges.len();
+    let lowest = |&i: &usize, &j: &usize| {
+        let (p, q) = (g.point(line.vertices[i]), g.point(line.vertices[j]));
+        (p.y, p.x)
+            .partial_cmp(&(q.y, q.x))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    };
+    let start = if reroot {
+        (0..m).min_by(lowest).unwrap_or(0)
+    } else {
+        0
+    };
+    // Rotate so that the loop starts (and ends) at `start`.
+    let vertices: Vec<u32> = (0..=m).map(|i| line.vertices[(start + i) % m]).collect();
+    let loop_edges: Vec<u32> = (0..m).map(|i| line.edges[(start + i) % m]).collect();
+    let mut length = vec![0.0; m + 1];
+    for i in 0..m {
+        let (p, q) = (g.point(vertices[i]), g.point(vertices[i + 1]));
+        length[i + 1] = length[i] + p.distance_squared(q).sqrt();
+    }
+    let total = length[m];
+    // Cut vertices at one and two thirds of the length, kept strictly inside and apart (a loop
+    // has at least three edges in a graph without duplicate edges).
+    let at = |fraction: f64| length.partition_point(|&l| l < fraction * total);
+    let c1 = at(1.0 / 3.0).clamp(1, m - 2);
+    let c2 = at(2.0 / 3.0).clamp(c1 + 1, m - 1);
+    [(0, c1), (c1, c2), (c2, m)]
+        .into_iter()
+        .map(|(i, j)| Polyline {
+            vertices: vertices[i..=j].to_vec(),
+            edges: loop_edges[i..j].to_vec(),
+            labels: line.labels,
+        })
+        .collect()
+}

@@ -1,0 +1,398 @@
+//! Topology-preserving Douglas–Peucker: the PSLG G' (DESIGN.md §2, step 5).
+//!
+//! Each polyline is simplified top-down: a chain whose vertices all lie within the tolerance of
+//! the chord between its ends is replaced by that chord — unless the chord would change the
+//! topology, in which case the farthest vertex is kept and both halves are tried in turn. The
+//! chord `s` replacing the chain `C` is safe when
+//!
+//! - `s` meets no other edge of the current graph (other than at its two ends), so the graph
+//!   stays planar; and
+//! - the region between `C` and `s` (the points around which the closed curve `C + s` winds, and
+//!   the curve itself) holds no vertex of the current graph other than those of `C`.
+//!
+//! With these, every edge that could enter the region would have to cross `s` or `C` or end
+//! inside it, so no curve is jumped over and no face is emptied; a face bounded by `C` and one
+//! other edge joining its ends would need `s` to overlap that edge, which the first test refuses.
+//! Polylines are simplified one after the other against the current state of all others, and a
+//! grid of the current edges and vertices keeps each test local.
+
+use imesh_geom::predicates::orient2d;
+use imesh_geom::Point;
+
+use crate::graph::{CurveGraph, GraphEdge};
+use crate::grid::{conflict, edge_cells, grid_for, within, CellLists, Grid};
+use crate::polyline::{polylines, Polyline};
+use crate::CurveError;
+
+/// Default simplification tolerance in pixels.
+pub const DEFAULT_TOLERANCE: f64 = 2.0;
+
+/// Options of [`simplify`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimplifyOptions {
+    /// The largest distance, in pixels, from a removed vertex to the simplified edge that
+    /// replaces it.
+    pub tolerance: f64,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: DEFAULT_TOLERANCE,
+        }
+    }
+}
+
+/// The simplified graph G' and where each of its edges comes from.
+#[derive(Clone, Debug)]
+pub struct Simplification {
+    /// The polylines of the input graph (see [`polylines`]).
+    pub polylines: Vec<Polyline>,
+    /// G': the same points as the input, with the simplified edges (labels as their polyline's).
+    /// Every polyline end is pinned.
+    pub graph: CurveGraph,
+    /// For each edge of G', the original vertices it replaces, from `ends[0]` to `ends[1]`.
+    pub chains: Vec<Vec<u32>>,
+    /// For each edge of G', the index of its polyline.
+    pub polyline_of: Vec<u32>,
+    /// Chords within the tolerance refused because they would have changed the topology.
+    pub refused: usize,
+    /// The largest distance from an original vertex to its simplified edge.
+    pub max_deviation: f64,
+}
+
+/// Simplifies every polyline of `g` (cut by [`polylines`]) with a topology-preserving
+/// Douglas–Peucker at `options.tolerance`.
+///
+/// # Errors
+/// [`CurveError::BadTolerance`] for a negative or non-finite tolerance.
+///
+/// ```
+/// use imesh_curves::{simplify, CurveGraph, GraphEdge, SimplifyOptions};
+/// use imesh_geom::Point;
+/// // A wavy open curve between two vertices of valence 1.
+/// let points: Vec<Point> = (0..=20).map(|i| Point::new(f64::from(i), 0.3 * f64::from(i % 2))).collect();
+/// let edges = (0..20u32).map(|i| GraphEdge { ends: [i, i + 1], labels: [1, 2] }).collect();
+/// let g = CurveGraph::new(points, edges)?;
+/// let s = simplify(&g, &SimplifyOptions { tolerance: 0.5 })?;
+/// assert_eq!(s.graph.edges().len(), 1);
+/// assert_eq!(s.chains[0].len(), 21);
+/// assert!(s.max_deviation <= 0.5);
+/// # Ok::<(), imesh_curves::CurveError>(())
+/// ```
+pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplification, CurveError> {
+    let tolerance = options.tolerance;
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(CurveError::BadTolerance { tolerance });
+    }
+    let lines = polylines(g);
+    let mut state = State::new(g);
+    let mut edges = Vec::new();
+    let mut chains = Vec::new();
+    let mut polyline_of = Vec::new();
+    let mut max_deviation: f64 = 0.0;
+    for (index, line) in lines.iter().enumerate() {
+        let kept = state.simplify_line(line, tolerance);
+        for w in kept.windows(2) {
+            let (i, j) = (w[0], w[1]);
+            let chain = line.vertices[i..=j].to_vec();
+            let (a, b) = (g.point(chain[0]), g.point(chain[chain.len() - 1]));
+            for &v in &chain[1..chain.len() - 1] {
+                max_deviation = max_deviation.max(segment_distance(a, b, g.point(v)));
+            }
+            edges.push(GraphEdge {
+                ends: [chain[0], chain[chain.len() - 1]],
+                labels: line.labels,
+            });
+            chains.push(chain);
+            polyline_of.push(index as u32);
+        }
+    }
+    let mut graph = CurveGraph::new(g.points().to_vec(), edges)?;
+    for line in &lines {
+        for v in line.ends() {
+            graph.pin(v)?;
+        }
+    }
+    Ok(Simplification {
+        polylines: lines,
+        graph,
+        chains,
+        polyline_of,
+        refused: state.refused,
+        max_deviation,
+    })
+}
+
+/// Distance from `q` to the closed segment `ab`.
+pub(crate) fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
+    segment_distance_squared(a, b, q).sqrt()
+}
+
+/// Squared distance from `q` to the closed segment `ab`.
+fn segment_distance_squared(a: Point, b: Point, q: Point) -> f64 {
+    let ab = b - a;
+    let len2 = ab.x * ab.x + ab.y * ab.y;
+    let t = if len2 > 0.0 {
+        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    q.distance_squared(a + ab * t)
+}
+
+/// The current graph during simplification: every edge (original, or a chord that replaced a
+/// chain) with a liveness flag, the live vertices, and the grid over both.
+struct State<'g> {
+    g: &'g CurveGraph,
+    grid: Grid,
+    ends: Vec<[u32; 2]>,
+    alive: Vec<bool>,
+    edge_cells: CellLists,
+    vertex_alive: Vec<bool>,
+    /// Vertices of each cell, compressed (`vertex_list[vertex_first[c]..vertex_first[c + 1]]`).
+    vertex_first: Vec<u32>,
+    vertex_list: Vec<u32>,
+    /// Per-edge and per-vertex stamps: "seen in this query", "in the chain under test".
+    edge_seen: Vec<u32>,
+    edge_in_chain: Vec<u32>,
+    vertex_seen: Vec<u32>,
+    vertex_in_chain: Vec<u32>,
+    query: u32,
+    refused: usize,
+}
+
+impl<'g> State<'g> {
+    fn new(g: &'g CurveGraph) -> Self {
+        let grid = grid_for(g);
+        let edge_cells = edge_cells(g, &grid);
+        let n = g.points().len();
+        let vertex_alive: Vec<bool> = (0..n as u32).map(|v| g.valence(v) > 0).collect();
+        let mut vertex_first = vec![0u32; grid.len() + 1];
+        for v in (0..n).filter(|&v| vertex_alive[v]) {
+            vertex_first[grid.cell(g.points()[v]) + 1] += 1;
+        }
+        for c in 0..grid.len() {
+            vertex_first[c + 1] += vertex_first[c];
+        }
+        let mut fill = vertex_first.clone();
+        let mut vertex_list = vec![0u32; vertex_first[grid.len()] as usize];
+        for v in (0..n).filter(|&v| vertex_alive[v]) {
+            let c = grid.cell(g.points()[v]);
+            vertex_list[fill[c] as usize] = v as u32;
+            fill[c] += 1;
+        }
+        let m = g.edges().len();
+        Self {
+            g,
+            grid,
+            ends: g.edges().iter().map(|e| e.ends).collect(),
+            alive: vec![true; m],
+            edge_cells,
+            vertex_alive,
+            vertex_first,
+            vertex_list,
+            edge_seen: vec![0; m],
+            edge_in_chain: vec![0; m],
+            vertex_seen: vec![0; n],
+            vertex_in_chain: vec![0; n],
+            query: 0,
+            refused: 0,
+        }
+    }
+
+    /// Douglas–Peucker on one polyline; returns the indices (into `line.vertices`) kept.
+    fn simplify_line(&mut self, line: &Polyline, tolerance: f64) -> Vec<usize> {
+        let v = &line.vertices;
+        let mut keep = vec![false; v.len()];
+        keep[0] = true;
+        keep[v.len() - 1] = true;
+        let mut stack = vec![(0, v.len() - 1)];
+        while let Some((i, j)) = stack.pop() {
+            if j <= i + 1 {
+                continue;
+            }
+            let (a, b) = (self.g.point(v[i]), self.g.point(v[j]));
+            let (mut far, mut deviation2) = (i + 1, -1.0);
+            for (k, &x) in v.iter().enumerate().take(j).skip(i + 1) {
+                let d2 = segment_distance_squared(a, b, self.g.point(x));
+                if d2 > deviation2 {
+                    (far, deviation2) = (k, d2);
+                }
+            }
+            let deviation = deviation2.sqrt();
+            if deviation <= tolerance {
+                if straight(self.g.points(), &v[i..=j]) || self.chord_is_safe(line, i, j, deviation)
+                {
+                    self.replace(line, i, j);
+                    continue;
+                }
+                self.refused += 1;
+            }
+            keep[far] = true;
+            stack.push((far, j));
+            stack.push((i, far));
+        }
+        (0..v.len()).filter(|&k| keep[k]).collect()
+    }
+
+    /// The two tests of the module documentation for the chord `v[i] v[j]` replacing the chain
+    /// `v[i..=j]`, whose vertices are within `deviation` of the chord.
+    fn chord_is_safe(&mut self, line: &Polyline, i: usize, j: usize, deviation: f64) -> bool {
+        self.query += 1;
+        let q = self.query;
+        let chain = &line.vertices[i..=j];
+        for &e in &line.edges[i..j] {
+            self.edge_in_chain[e as usize] = q;
+        }
+        for &x in chain {
+            self.vertex_in_chain[x as usize] = q;
+        }
+        let chord = [chain[0], chain[chain.len() - 1]];
+        let points = self.g.points();
+        let (a, b) = (points[chord[0] as usize], points[chord[1] as usize]);
+
+        // 1. The chord meets no other current edge (the bounding boxes must overlap first).
+        let (lo, hi) = bounding_box([a, b].into_iter());
+        let mut safe = true;
+        let (edge_cells, ends, alive) = (&self.edge_cells, &self.ends, &self.alive);
+        let (edge_seen, edge_in_chain) = (&mut self.edge_seen, &self.edge_in_chain);
+        self.grid.cells_near_segment(a, b, 0.0, |c| {
+            if !safe {
+                return;
+            }
+            for e in edge_cells.iter(c) {
+                let e = e as usize;
+                if edge_seen[e] == q || !alive[e] || edge_in_chain[e] == q {
+                    continue;
+                }
+                edge_seen[e] = q;
+                let [u, w] = ends[e];
+                let (pu, pw) = (points[u as usize], points[w as usize]);
+                if pu.x.max(pw.x) < lo.x
+                    || pu.x.min(pw.x) > hi.x
+                    || pu.y.max(pw.y) < lo.y
+                    || pu.y.min(pw.y) > hi.y
+                {
+                    continue;
+                }
+                if conflict(points, chord, ends[e]) {
+                    safe = false;
+                    return;
+                }
+            }
+        });
+        if !safe {
+            return false;
+        }
+
+        // 2. No other current vertex in the region between the chain and the chord.
+        let (lo, hi) = bounding_box(chain.iter().map(|&x| points[x as usize]));
+        let (vertex_first, vertex_list) = (&self.vertex_first, &self.vertex_list);
+        let (vertex_alive, vertex_in_chain) = (&self.vertex_alive, &self.vertex_in_chain);
+        let vertex_seen = &mut self.vertex_seen;
+        let pad = deviation * (1.0 + 1e-12) + 1e-12;
+        self.grid.cells_near_segment(a, b, pad, |c| {
+            if !safe {
+                return;
+            }
+            let list = &vertex_list[vertex_first[c] as usize..vertex_first[c + 1] as usize];
+            for &x in list {
+                let xi = x as usize;
+                if vertex_seen[xi] == q || !vertex_alive[xi] || vertex_in_chain[xi] == q {
+                    continue;
+                }
+                vertex_seen[xi] = q;
+                let p = points[xi];
+                if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+                    continue;
+                }
+                if encloses(points, chain, p) {
+                    safe = false;
+                    return;
+                }
+            }
+        });
+        safe
+    }
+
+    /// Replaces the chain `v[i..=j]` by its chord in the current graph.
+    fn replace(&mut self, line: &Polyline, i: usize, j: usize) {
+        for &e in &line.edges[i..j] {
+            self.alive[e as usize] = false;
+        }
+        for &x in &line.vertices[i + 1..j] {
+            self.vertex_alive[x as usize] = false;
+        }
+        let id = self.ends.len() as u32;
+        let chord = [line.vertices[i], line.vertices[j]];
+        self.ends.push(chord);
+        self.alive.push(true);
+        self.edge_seen.push(0);
+        self.edge_in_chain.push(0);
+        let (a, b) = (self.g.point(chord[0]), self.g.point(chord[1]));
+        let cells = &mut self.edge_cells;
+        self.grid
+            .cells_near_segment(a, b, 0.0, |c| cells.push(c, id));
+    }
+}
+
+/// True when every vertex of the chain lies exactly on the segment between its ends: the chord
+/// is then the chain itself as a point set, and replacing one by the other changes nothing.
+/// (A simple chain on one line runs monotonically from one end to the other.)
+fn straight(points: &[Point], chain: &[u32]) -> bool {
+    let (a, b) = (
+        points[chain[0] as usize],
+        points[chain[chain.len() - 1] as usize],
+    );
+    chain[1..chain.len() - 1]
+        .iter()
+        .all(|&v| orient2d(a, b, points[v as usize]) == 0.0)
+}
+
+fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
+    points.fold(
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
+    )
+}
+
+/// True when `p` lies on the closed curve `chain + chord` (chain closed back to its start) or the
+/// curve winds around it. Exact: winding number by upward/downward crossings decided with
+/// `orient2d`.
+fn encloses(points: &[Point], chain: &[u32], p: Point) -> bool {
+    let mut winding = 0i64;
+    let closing = [chain[chain.len() - 1], chain[0]];
+    let edges = chain
+        .windows(2)
+        .map(|w| [w[0], w[1]])
+        .chain(std::iter::once(closing));
+    for [u, w] in edges {
+        let (a, b) = (points[u as usize], points[w as usize]);
+        let in_y = (a.y <= p.y) != (b.y <= p.y);
+        let in_box = within(a, b, p);
+        if !in_y && !in_box {
+            continue;
+        }
+        let o = orient2d(a, b, p);
+        if o == 0.0 && in_box {
+            return true;
+        }
+        if in_y {
+            if a.y <= p.y && o > 0.0 {
+                winding += 1;
+            } else if a.y > p.y && o < 0.0 {
+                winding -= 1;
+            }
+        }
+    }
+    winding != 0
+}

@@ -1,0 +1,393 @@
+//! Polylines and topology-preserving simplification on real and random boundary graphs.
+
+mod support;
+
+use imesh_curves::{
+    fit_edges, polylines, simplify, CurveError, CurveGraph, FitOptions, GraphEdge, Simplification,
+    SimplifyOptions,
+};
+use imesh_geom::Point;
+use proptest::prelude::*;
+
+/// What identifies a face independently of simplification: its label, the sign of its area,
+/// and the polylines around it with the direction each is walked in.
+type Signature = (u32, bool, Vec<(u32, bool)>);
+
+fn signatures(g: &CurveGraph, direction_of: impl Fn(u32, bool) -> (u32, bool)) -> Vec<Signature> {
+    let mut all: Vec<Signature> = g
+        .faces()
+        .into_iter()
+        .map(|f| {
+            let mut around: Vec<(u32, bool)> = f
+                .walk
+                .iter()
+                .map(|&(e, fwd)| direction_of(e, fwd))
+                .collect();
+            around.sort_unstable();
+            around.dedup();
+            (f.label, f.area > 0.0, around)
+        })
+        .collect();
+    all.sort();
+    all
+}
+
+/// Checks everything the issue asks of G' against G.
+fn check_simplification(g: &CurveGraph, s: &Simplification, tolerance: f64) {
+    // Every edge of G in exactly one polyline, and polylines are chains of G's edges.
+    let mut owner = vec![(u32::MAX, false); g.edges().len()];
+    for (l, line) in s.polylines.iter().enumerate() {
+        assert_eq!(line.vertices.len(), line.edges.len() + 1);
+        for (i, &e) in line.edges.iter().enumerate() {
+            assert_eq!(owner[e as usize].0, u32::MAX, "edge {e} in two polylines");
+            let ends = g.edges()[e as usize].ends;
+            let forward = ends == [line.vertices[i], line.vertices[i + 1]];
+            assert!(forward || ends == [line.vertices[i + 1], line.vertices[i]]);
+            owner[e as usize] = (l as u32, forward);
+        }
+        let [a, b] = line.ends();
+        assert_ne!(a, b, "a polyline is open");
+    }
+    assert!(
+        owner.iter().all(|o| o.0 != u32::MAX),
+        "every edge is in a polyline"
+    );
+
+    // G' is planar, and every removed vertex is within the tolerance of its edge.
+    assert_eq!(s.graph.crossing(), None, "simplified edges cross");
+    for (k, chain) in s.chains.iter().enumerate() {
+        let [a, b] = s.graph.edges()[k].ends;
+        assert_eq!([chain[0], chain[chain.len() - 1]], [a, b]);
+        let (pa, pb) = (g.point(a), g.point(b));
+        for &v in chain {
+            let d = distance_to_segment(pa, pb, g.point(v));
+            assert!(
+                d <= tolerance * (1.0 + 1e-12) + 1e-12,
+                "vertex {v} is {d} px from its edge"
+            );
+        }
+    }
+    assert!(s.max_deviation <= tolerance * (1.0 + 1e-12) + 1e-12);
+
+    // The same faces with the same labels, none of zero area, labels consistent around each.
+    let before = signatures(g, |e, fwd| {
+        let (l, forward) = owner[e as usize];
+        (l, fwd == forward)
+    });
+    let after = signatures(&s.graph, |e, fwd| (s.polyline_of[e as usize], fwd));
+    assert_eq!(before, after, "the faces changed");
+    for f in s.graph.faces() {
+        assert!(f.consistent, "a face of G' has two labels");
+        assert!(f.area != 0.0, "a face of G' has no area");
+    }
+}
+
+fn distance_to_segment(a: Point, b: Point, q: Point) -> f64 {
+    let ab = b - a;
+    let len2 = ab.x * ab.x + ab.y * ab.y;
+    let t = if len2 > 0.0 {
+        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    q.distance_squared(a + ab * t).sqrt()
+}
+
+/// A random planar label image: nearest-seed regions plus isolated noise pixels.
+fn label_image() -> impl Strategy<Value = (u32, u32, Vec<u32>)> {
+    (3u32..22, 3u32..22).prop_flat_map(|(w, h)| {
+        let seeds = prop::collection::vec((0..w, 0..h, 0u32..4), 1..7);
+        let noise = prop::collection::vec((0..w, 0..h, 0u32..4), 0..8);
+        (Just(w), Just(h), seeds, noise).prop_map(|(w, h, seeds, noise)| {
+            let mut labels = vec![0u32; (w * h) as usize];
+            for r in 0..h {
+                for c in 0..w {
+                    let nearest = seeds
+                        .iter()
+                        .min_by_key(|&&(x, y, _)| {
+                            let (dx, dy) =
+                                (i64::from(x) - i64::from(c), i64::from(y) - i64::from(r));
+                            (dx * dx + dy * dy, x, y)
+                        })
+                        .map_or(0, |s| s.2);
+                    labels[(r * w + c) as usize] = nearest;
+                }
+            }
+            for (x, y, l) in noise {
+                labels[(y * w + x) as usize] = l;
+            }
+            (w, h, labels)
+        })
+    })
+}
+
+const TOLERANCES: [f64; 4] = [0.5, 2.0, 5.0, 15.0];
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn pixel_boundary_graphs_keep_their_topology((w, h, labels) in label_image()) {
+        let g = support::pixel_boundaries(&support::grid(w, h, labels));
+        prop_assert_eq!(g.crossing(), None);
+        for tolerance in TOLERANCES {
+            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            check_simplification(&g, &s, tolerance);
+        }
+    }
+
+    #[test]
+    fn imesh_c_edge_graphs_keep_their_topology((w, h, labels) in label_image()) {
+        let g = support::imesh_boundaries(&support::grid(w, h, labels));
+        prop_assert_eq!(g.crossing(), None);
+        for tolerance in TOLERANCES {
+            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            check_simplification(&g, &s, tolerance);
+        }
+    }
+}
+
+fn edge(a: u32, b: u32, labels: [u32; 2]) -> GraphEdge {
+    GraphEdge {
+        ends: [a, b],
+        labels,
+    }
+}
+
+/// A closed loop through `points`, label 1 on its positive side.
+fn loop_graph(points: Vec<Point>) -> CurveGraph {
+    let n = points.len() as u32;
+    let edges = (0..n).map(|i| edge(i, (i + 1) % n, [1, 0])).collect();
+    CurveGraph::new(points, edges).unwrap()
+}
+
+#[test]
+fn a_loop_keeps_three_vertices_and_its_area_at_any_tolerance() {
+    let points = (0..40)
+        .map(|i| {
+            let a = f64::from(i) * std::f64::consts::TAU / 40.0;
+            Point::new(3.0 * a.cos(), 3.0 * a.sin())
+        })
+        .collect();
+    let g = loop_graph(points);
+    let s = simplify(&g, &SimplifyOptions { tolerance: 1000.0 }).unwrap();
+    assert_eq!(s.graph.edges().len(), 3);
+    check_simplification(&g, &s, 1000.0);
+    let inner = s.graph.faces().into_iter().find(|f| f.label == 1).unwrap();
+    assert!(
+        inner.area > 5.0,
+        "the loop kept a real triangle: {}",
+        inner.area
+    );
+}
+
+#[test]
+fn a_chord_never_jumps_over_an_island() {
+    // A U-shaped curve from (0, 0) to (10, 0) dipping to y = 1, closed by a box above it (label 3
+    // inside, 2 outside), with a small island (a triangle of label 4) inside the U. At
+    // tolerance 5 the whole U would be one chord.
+    let mut points: Vec<Point> = (0..=10)
+        .map(|i| Point::new(f64::from(i), if (1..10).contains(&i) { 1.0 } else { 0.0 }))
+        .collect();
+    let n = points.len() as u32;
+    let mut edges: Vec<GraphEdge> = (0..n - 1).map(|i| edge(i, i + 1, [2, 3])).collect();
+    points.extend([
+        Point::new(4.0, 0.4),
+        Point::new(6.0, 0.4),
+        Point::new(5.0, 0.8),
+    ]);
+    edges.extend([
+        edge(n, n + 1, [4, 3]),
+        edge(n + 1, n + 2, [4, 3]),
+        edge(n + 2, n, [4, 3]),
+    ]);
+    points.extend([Point::new(10.0, -2.0), Point::new(0.0, -2.0)]);
+    edges.extend([
+        edge(n - 1, n + 3, [2, 3]),
+        edge(n + 3, n + 4, [2, 3]),
+        edge(n + 4, 0, [2, 3]),
+    ]);
+    let g = CurveGraph::new(points, edges).unwrap();
+    let s = simplify(&g, &SimplifyOptions { tolerance: 5.0 }).unwrap();
+    assert!(s.refused > 0, "the chord over the island was refused");
+    check_simplification(&g, &s, 5.0);
+}
+
+#[test]
+fn two_curves_between_the_same_ends_do_not_merge() {
+    // A lens: two arcs from (0, 0) to (10, 0), one on each side, whose ends have valence 3
+    // (a tail leaves each end). Simplified to chords, both arcs would be the same segment.
+    let mut points = vec![Point::new(0.0, 0.0), Point::new(10.0, 0.0)];
+    let mut edges = Vec::new();
+    for (sign, labels) in [(1.0, [0, 1]), (-1.0, [1, 0])] {
+        let mut prev = 0;
+        for i in 1..10 {
+            let x = f64::from(i);
+            points.push(Point::new(x, sign * 0.3 * (x * (10.0 - x)).sqrt()));
+            let v = points.len() as u32 - 1;
+            edges.push(edge(prev, v, labels));
+            prev = v;
+        }
+        edges.push(edge(prev, 1, labels));
+    }
+    points.extend([Point::new(-5.0, 0.0), Point::new(15.0, 0.0)]);
+    let n = points.len() as u32;
+    edges.extend([edge(n - 2, 0, [0, 0]), edge(1, n - 1, [0, 0])]);
+    let g = CurveGraph::new(points, edges).unwrap();
+    let s = simplify(&g, &SimplifyOptions { tolerance: 5.0 }).unwrap();
+    check_simplification(&g, &s, 5.0);
+    assert_eq!(polylines(&g).len(), 4);
+    assert!(s.refused > 0, "the second chord was refused");
+}
+
+#[test]
+fn the_domain_border_is_cut_at_the_corners() {
+    let (w, h) = (6, 4);
+    let g = support::pixel_boundaries(&support::grid(w, h, vec![0; 24]));
+    let lines = polylines(&g);
+    assert_eq!(lines.len(), 4, "one polyline per side of the domain");
+    let s = simplify(&g, &SimplifyOptions::default()).unwrap();
+    assert_eq!(s.graph.edges().len(), 4);
+    check_simplification(&g, &s, 2.0);
+}
+
+#[test]
+fn a_loop_hanging_off_a_junction_is_cut_too() {
+    // A square loop 0-1-2-3 with a tail 0-4: vertex 0 has valence 3, the loop starts and ends
+    // there and must still become three pieces.
+    let points = vec![
+        Point::new(0.0, 0.0),
+        Point::new(4.0, 0.0),
+        Point::new(4.0, 4.0),
+        Point::new(0.0, 4.0),
+        Point::new(-3.0, -3.0),
+    ];
+    let edges = vec![
+        edge(0, 1, [1, 0]),
+        edge(1, 2, [1, 0]),
+        edge(2, 3, [1, 0]),
+        edge(3, 0, [1, 0]),
+        edge(0, 4, [0, 0]),
+    ];
+    let g = CurveGraph::new(points, edges).unwrap();
+    let lines = polylines(&g);
+    assert_eq!(lines.len(), 4);
+    assert!(lines.iter().all(|l| l.ends()[0] != l.ends()[1]));
+}
+
+#[test]
+fn real_fixture_boundaries_simplify_with_their_topology() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images/skimage-coins.png");
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    let grey = imesh_classify::luminance(&image);
+    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 2));
+    for g in [
+        support::pixel_boundaries(&grid),
+        support::imesh_boundaries(&grid),
+    ] {
+        for tolerance in TOLERANCES {
+            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            check_simplification(&g, &s, tolerance);
+            assert!(s.graph.edges().len() < g.edges().len());
+        }
+    }
+}
+
+#[test]
+fn bad_graphs_and_tolerances_are_refused_with_typed_errors() {
+    let p = vec![Point::new(0.0, 0.0), Point::new(1.0, 0.0)];
+    assert_eq!(
+        CurveGraph::new(p.clone(), vec![edge(0, 0, [0, 1])]).unwrap_err(),
+        CurveError::BadEdge {
+            index: 0,
+            ends: [0, 0]
+        }
+    );
+    assert_eq!(
+        CurveGraph::new(p.clone(), vec![edge(0, 7, [0, 1])]).unwrap_err(),
+        CurveError::BadEdge {
+            index: 0,
+            ends: [0, 7]
+        }
+    );
+    assert_eq!(
+        CurveGraph::new(p.clone(), vec![edge(0, 1, [0, 1]), edge(1, 0, [1, 0])]).unwrap_err(),
+        CurveError::DuplicateEdge { ends: [1, 0] }
+    );
+    assert_eq!(
+        CurveGraph::new(vec![Point::new(f64::NAN, 0.0)], vec![]).unwrap_err(),
+        CurveError::NonFinitePoint { index: 0 }
+    );
+    let g = CurveGraph::new(p, vec![edge(0, 1, [0, 1])]).unwrap();
+    for tolerance in [-1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            simplify(&g, &SimplifyOptions { tolerance }),
+            Err(CurveError::BadTolerance { .. })
+        ));
+    }
+    let mut g = g;
+    assert_eq!(g.pin(9), Err(CurveError::BadVertex { vertex: 9 }));
+}
+
+#[test]
+fn crossing_edges_are_found() {
+    let points = vec![
+        Point::new(0.0, 0.0),
+        Point::new(2.0, 2.0),
+        Point::new(0.0, 2.0),
+        Point::new(2.0, 0.0),
+        Point::new(1.0, 1.0),
+    ];
+    let g = CurveGraph::new(points.clone(), vec![edge(0, 1, [0, 1]), edge(2, 3, [0, 1])]).unwrap();
+    assert_eq!(g.crossing(), Some([0, 1]));
+    // A vertex on another edge (a T without a shared vertex) is a crossing too.
+    let g = CurveGraph::new(points, vec![edge(0, 1, [0, 1]), edge(4, 3, [0, 1])]).unwrap();
+    assert_eq!(g.crossing(), Some([0, 1]));
+}
+
+#[test]
+fn fitted_curves_join_the_simplified_vertices_within_the_tolerance() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images/skimage-coins.png");
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    let grey = imesh_classify::luminance(&image);
+    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 3));
+    let g = support::imesh_boundaries(&grid);
+    for tolerance in [0.5, 2.0, 5.0] {
+        let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+        let report = fit_edges(&s, &g, &FitOptions::default());
+        assert_eq!(report.fits.len(), s.graph.edges().len());
+        for (fit, e) in report.fits.iter().zip(s.graph.edges()) {
+            assert_eq!(fit.curve.control[0], g.point(e.ends[0]));
+            assert_eq!(fit.curve.control[3], g.point(e.ends[1]));
+            // Never worse than the simplified edge itself.
+            assert!(
+                fit.max_error <= tolerance + 1e-9,
+                "{} > {tolerance}",
+                fit.max_error
+            );
+        }
+        assert!(report.rms_error <= report.max_error);
+        // Curved boundaries: the cubics are closer to the chains than the straight edges.
+        let straight_rms = rms_to_edges(&g, &s);
+        assert!(
+            report.rms_error < straight_rms,
+            "{} vs {straight_rms}",
+            report.rms_error
+        );
+    }
+}
+
+fn rms_to_edges(g: &CurveGraph, s: &Simplification) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for chain in &s.chains {
+        let (a, b) = (g.point(chain[0]), g.point(chain[chain.len() - 1]));
+        for &v in chain {
+            let d = distance_to_segment(a, b, g.point(v));
+            sum += d * d;
+            count += 1;
+        }
+    }
+    (sum / count as f64).sqrt()
+}

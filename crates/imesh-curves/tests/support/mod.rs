@@ -1,0 +1,89 @@
+//! Boundary graphs of label grids, shared by the tests and the benchmark.
+
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+
+use imesh_classify::{LabelGrid, Region};
+use imesh_curves::{CurveGraph, GraphEdge};
+use imesh_geom::Point;
+use imesh_segment::{SampleOptions, SegmentedMesh, OUTSIDE};
+
+/// A label grid from raw labels (regions named after their index).
+pub fn grid(width: u32, height: u32, labels: Vec<u32>) -> LabelGrid {
+    let count = labels.iter().max().map_or(1, |&m| m + 1);
+    let regions = (0..count)
+        .map(|i| Region {
+            name: format!("r{i}"),
+            colour: [i as u8; 3],
+        })
+        .collect();
+    LabelGrid::new(width, height, labels, regions).expect("a consistent grid")
+}
+
+/// The pixel-boundary graph: pixel corners as vertices, every pixel side between two labels (or
+/// on the domain border) as an edge. A staircase graph with long collinear runs.
+pub fn pixel_boundaries(grid: &LabelGrid) -> CurveGraph {
+    let (w, h) = (grid.width() as i64, grid.height() as i64);
+    let label = |c: i64, r: i64| {
+        if c < 0 || r < 0 || c >= w || r >= h {
+            OUTSIDE
+        } else {
+            grid.label(c as u32, r as u32)
+        }
+    };
+    let mut ids: HashMap<(i64, i64), u32> = HashMap::new();
+    let mut points = Vec::new();
+    let mut id = |c: i64, r: i64, points: &mut Vec<Point>| {
+        *ids.entry((c, r)).or_insert_with(|| {
+            points.push(Point::new(c as f64, r as f64));
+            (points.len() - 1) as u32
+        })
+    };
+    let mut edges = Vec::new();
+    for r in 0..=h {
+        for c in 0..w {
+            // Side from corner (c, r) to (c + 1, r): pixel row r on its positive side.
+            let (below, above) = (label(c, r), label(c, r - 1));
+            if below != above {
+                let ends = [id(c, r, &mut points), id(c + 1, r, &mut points)];
+                edges.push(GraphEdge {
+                    ends,
+                    labels: [below, above],
+                });
+            }
+        }
+    }
+    for c in 0..=w {
+        for r in 0..h {
+            // Side from corner (c, r) to (c, r + 1): pixel column c − 1 on its positive side.
+            let (left, right) = (label(c - 1, r), label(c, r));
+            if left != right {
+                let ends = [id(c, r, &mut points), id(c, r + 1, &mut points)];
+                edges.push(GraphEdge {
+                    ends,
+                    labels: [left, right],
+                });
+            }
+        }
+    }
+    let mut g = CurveGraph::new(points, edges).expect("a valid pixel-boundary graph");
+    g.pin_domain_corners(w as f64, h as f64);
+    g
+}
+
+/// The Imesh c-edge graph of `grid` (sampling and partition, DESIGN.md §2 steps 2–3).
+pub fn imesh_boundaries(grid: &LabelGrid) -> CurveGraph {
+    let m = SegmentedMesh::from_grid(grid, &SampleOptions::default()).expect("sampling works");
+    let edges = m
+        .c_edges
+        .iter()
+        .map(|e| GraphEdge {
+            ends: [e.vertices[0].index() as u32, e.vertices[1].index() as u32],
+            labels: e.labels,
+        })
+        .collect();
+    let mut g = CurveGraph::new(m.triangulation.points().to_vec(), edges).expect("valid c-edges");
+    g.pin_domain_corners(f64::from(grid.width()), f64::from(grid.height()));
+    g
+}
