@@ -85,8 +85,8 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(CurveError::BadTolerance { tolerance });
     }
-    let lines = polylines(g);
-    let mut state = State::new(g);
+    // Cutting the polylines and indexing the graph are independent.
+    let (lines, mut state) = rayon::join(|| polylines(g), || State::new(g));
     let mut edges = Vec::new();
     let mut chains = Vec::new();
     let mut polyline_of = Vec::new();
@@ -165,23 +165,13 @@ struct State<'g> {
 impl<'g> State<'g> {
     fn new(g: &'g CurveGraph) -> Self {
         let grid = grid_for(g);
-        let edge_cells = edge_cells(g, &grid);
         let n = g.points().len();
         let vertex_alive: Vec<bool> = (0..n as u32).map(|v| g.valence(v) > 0).collect();
-        let mut vertex_first = vec![0u32; grid.len() + 1];
-        for v in (0..n).filter(|&v| vertex_alive[v]) {
-            vertex_first[grid.cell(g.points()[v]) + 1] += 1;
-        }
-        for c in 0..grid.len() {
-            vertex_first[c + 1] += vertex_first[c];
-        }
-        let mut fill = vertex_first.clone();
-        let mut vertex_list = vec![0u32; vertex_first[grid.len()] as usize];
-        for v in (0..n).filter(|&v| vertex_alive[v]) {
-            let c = grid.cell(g.points()[v]);
-            vertex_list[fill[c] as usize] = v as u32;
-            fill[c] += 1;
-        }
+        // The edge lists and the vertex lists are independent: build them side by side.
+        let (edge_cells, (vertex_first, vertex_list)) = rayon::join(
+            || edge_cells(g, &grid),
+            || vertex_cells(g, &grid, &vertex_alive),
+        );
         let m = g.edges().len();
         Self {
             g,
@@ -348,6 +338,27 @@ fn straight(points: &[Point], chain: &[u32]) -> bool {
     chain[1..chain.len() - 1]
         .iter()
         .all(|&v| orient2d(a, b, points[v as usize]) == 0.0)
+}
+
+/// The live vertices of each grid cell, compressed: those of cell `c` are
+/// `list[first[c]..first[c + 1]]`.
+fn vertex_cells(g: &CurveGraph, grid: &Grid, alive: &[bool]) -> (Vec<u32>, Vec<u32>) {
+    let points = g.points();
+    let mut first = vec![0u32; grid.len() + 1];
+    for v in (0..points.len()).filter(|&v| alive[v]) {
+        first[grid.cell(points[v]) + 1] += 1;
+    }
+    for c in 0..grid.len() {
+        first[c + 1] += first[c];
+    }
+    let mut fill = first.clone();
+    let mut list = vec![0u32; first[grid.len()] as usize];
+    for v in (0..points.len()).filter(|&v| alive[v]) {
+        let c = grid.cell(points[v]);
+        list[fill[c] as usize] = v as u32;
+        fill[c] += 1;
+    }
+    (first, list)
 }
 
 fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
