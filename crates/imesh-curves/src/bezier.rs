@@ -167,6 +167,16 @@ pub struct CurveFit {
     pub max_error: f64,
     /// The root mean square of those distances.
     pub rms_error: f64,
+    /// The largest distance from a point of the curve to the chain (the other half of the
+    /// Hausdorff distance: a cubic can swing away between the points it fits).
+    pub curve_deviation: f64,
+}
+
+impl CurveFit {
+    /// The Hausdorff distance between the curve and the chain (as sampled).
+    pub fn hausdorff(&self) -> f64 {
+        self.max_error.max(self.curve_deviation)
+    }
 }
 
 /// Fits a cubic Bézier to the chain `points` (at least two): ends fixed at the chain's ends, the
@@ -237,7 +247,8 @@ pub fn fit_cubic(points: &[Point], options: &FitOptions) -> CurveFit {
             break;
         }
     }
-    if chord_fit.max_error <= best.max_error {
+    best.curve_deviation = curve_deviation(&best.curve, points, &t);
+    if chord_fit.hausdorff() <= best.hausdorff() {
         chord_fit
     } else {
         best
@@ -380,11 +391,59 @@ fn measure_segment(a: Point, b: Point, points: &[Point]) -> CurveFit {
         max = max.max(d2.sqrt());
         sum += d2;
     }
+    let curve = CubicBezier::segment(a, b);
+    let t: Vec<f64> = points.iter().map(|&p| projection(a, b, p)).collect();
     CurveFit {
-        curve: CubicBezier::segment(a, b),
+        curve,
         max_error: max,
         rms_error: (sum / points.len() as f64).sqrt(),
+        curve_deviation: curve_deviation(&curve, points, &t),
     }
+}
+
+/// The parameter of the projection of `p` on the segment `ab`.
+fn projection(a: Point, b: Point, p: Point) -> f64 {
+    let ab = b - a;
+    let len2 = ab.x * ab.x + ab.y * ab.y;
+    if len2 > 0.0 {
+        (((p.x - a.x) * ab.x + (p.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Distance from `q` to the closed segment `ab`.
+fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
+    q.distance_squared(a + (b - a) * projection(a, b, q)).sqrt()
+}
+
+/// How far the curve strays from the chain `points` (whose projections on the curve are at `t`):
+/// the curve is sampled between consecutive projections (distance to the nearby chain edges) and
+/// uniformly (distance to the whole chain), and the largest distance is returned. An upper
+/// bound of the true value at the samples.
+fn curve_deviation(curve: &CubicBezier, points: &[Point], t: &[f64]) -> f64 {
+    let n = points.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let near = |q: Point, range: std::ops::Range<usize>| {
+        range
+            .map(|j| segment_distance(points[j], points[j + 1], q))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut worst: f64 = 0.0;
+    for i in 0..n - 1 {
+        let window = i.saturating_sub(2)..(i + 3).min(n - 1);
+        for s in [0.25, 0.5, 0.75] {
+            let q = curve.eval(t[i] + (t[i + 1] - t[i]) * s);
+            worst = worst.max(near(q, window.clone()));
+        }
+    }
+    for k in 0..=32 {
+        let q = curve.eval(f64::from(k) / 32.0);
+        worst = worst.max(near(q, 0..n - 1));
+    }
+    worst
 }
 
 /// The fit errors of `curve` to `points`; `t` holds each point's parameter guess on entry and
@@ -407,5 +466,6 @@ fn measure(curve: CubicBezier, points: &[Point], t: &mut [f64], near: bool) -> C
         curve,
         max_error: max,
         rms_error: (sum / points.len() as f64).sqrt(),
+        curve_deviation: 0.0,
     }
 }

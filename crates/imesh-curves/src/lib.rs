@@ -92,6 +92,8 @@ pub struct FitReport {
     pub max_error: f64,
     /// The root mean square of those distances over all chain points.
     pub rms_error: f64,
+    /// The largest distance from a point of a curve to its chain.
+    pub max_curve_deviation: f64,
 }
 
 /// Fits a cubic Bézier to the original chain of every edge of `s.graph` (`original` is the
@@ -108,9 +110,11 @@ pub fn fit_edges(s: &Simplification, original: &CurveGraph, options: &FitOptions
         })
         .collect();
     let mut max_error: f64 = 0.0;
+    let mut max_curve_deviation: f64 = 0.0;
     let (mut sum, mut count) = (0.0, 0usize);
     for (fit, chain) in fits.iter().zip(&s.chains) {
         max_error = max_error.max(fit.max_error);
+        max_curve_deviation = max_curve_deviation.max(fit.curve_deviation);
         sum += fit.rms_error * fit.rms_error * chain.len() as f64;
         count += chain.len();
     }
@@ -122,5 +126,6 @@ pub fn fit_edges(s: &Simplification, original: &CurveGraph, options: &FitOptions
         } else {
             0.0
         },
+        max_curve_deviation,
     }
 }

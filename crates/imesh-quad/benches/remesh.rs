@@ -1,0 +1,96 @@
+//! Criterion benchmark of the quad stage after DT': pairing, patches, templates and boundary
+//! adaptation, on the DT' of a real image's simplified boundaries (scikit-image's "grass",
+//! 512 × 512, Otsu: thousands of blades; about 10^5 triangles).
+//!
+//! `cargo bench -p imesh-quad`. Goal: pairing + templates + adaptation in < 50 ms.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use imesh_classify::{luminance, threshold};
+use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
+use imesh_quad::{
+    adapt, ControlNet, DensityOptions, ElementMesh, Pairing, QuadMesh, RegionTriangulation,
+};
+use imesh_segment::{SampleOptions, SegmentedMesh};
+
+fn bench(c: &mut Criterion) {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-grass.png");
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS)
+        .expect("the fixture skimage-grass.png loads");
+    let grey = luminance(&image);
+    let grid = threshold(&grey, &[imageproc_otsu(&grey)]);
+    let m = SegmentedMesh::from_grid(&grid, &SampleOptions::default()).expect("sampling works");
+    let edges = m
+        .c_edges
+        .iter()
+        .map(|e| GraphEdge {
+            ends: e.vertices.map(|v| v.index() as u32),
+            labels: e.labels,
+        })
+        .collect();
+    let mut g = CurveGraph::new(m.triangulation.points().to_vec(), edges).expect("valid c-edges");
+    g.pin_domain_corners(f64::from(grid.width()), f64::from(grid.height()));
+    let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
+    let curves: Vec<_> = fit_edges(&s, &g, &FitOptions::default())
+        .fits
+        .iter()
+        .map(|f| f.curve)
+        .collect();
+    let dt = RegionTriangulation::new(&s.graph, &DensityOptions::default()).expect("DT' builds");
+    let triangles = dt.triangulation.num_triangles();
+    eprintln!(
+        "grass: {} c-edges, {} G' edges, DT' {triangles} triangles",
+        g.edges().len(),
+        s.graph.edges().len()
+    );
+
+    {
+        let elements = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+        let mut net = ControlNet::straight(&dt.triangulation, &elements);
+        let mut q = QuadMesh::build(&dt.triangulation, &elements, &net, 1);
+        let t0 = std::time::Instant::now();
+        let (report, _) = adapt(&dt, &s.graph, &curves, &elements, &mut net, &mut q);
+        eprintln!(
+            "{} quads, {} unpaired; adaptation {:?} in {:?}",
+            q.quads.len(),
+            elements.unpaired,
+            report,
+            t0.elapsed()
+        );
+    }
+    let mut group = c.benchmark_group("quad stage grass");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(triangles as u64));
+    for pairing in [Pairing::Greedy, Pairing::Matching] {
+        group.bench_function(format!("pair {pairing:?}, {triangles} triangles"), |b| {
+            b.iter(|| black_box(ElementMesh::pair(&dt.triangulation, pairing)))
+        });
+    }
+    let elements = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+    group.bench_function("patches + templates k = 1", |b| {
+        b.iter(|| {
+            let net = ControlNet::straight(&dt.triangulation, &elements);
+            black_box(QuadMesh::build(&dt.triangulation, &elements, &net, 1))
+        })
+    });
+    group.bench_function("pair + patches + templates + adaptation (the goal)", |b| {
+        b.iter(|| {
+            let elements = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+            let mut net = ControlNet::straight(&dt.triangulation, &elements);
+            let mut q = QuadMesh::build(&dt.triangulation, &elements, &net, 1);
+            black_box(adapt(&dt, &s.graph, &curves, &elements, &mut net, &mut q))
+        })
+    });
+    group.finish();
+}
+
+/// Otsu's threshold through the classify crate's multi-level Otsu with two classes.
+fn imageproc_otsu(grey: &image::GrayImage) -> u8 {
+    imesh_classify::multi_otsu_levels(grey, 2)[0]
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,295 @@
+//! Boundary adaptation: the patches' boundary curves on G' edges take the fitted Béziers
+//! (DESIGN.md §2, step 9; the paper's section V-C).
+
+use imesh_curves::{CubicBezier, CurveGraph};
+use imesh_geom::Point;
+
+use crate::dt::{RegionTriangulation, NONE};
+use crate::mesh::QuadMesh;
+use crate::pairing::ElementMesh;
+use crate::patch::ControlNet;
+
+/// What boundary adaptation did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdaptReport {
+    /// M edges on G' edges, given their fitted sub-curve.
+    pub adapted_edges: usize,
+    /// Patches whose inner control points were relaxed because a quad inside had turned invalid.
+    pub relaxed_patches: usize,
+    /// G' edges pulled back towards their straight segment (their vertices are then between the
+    /// chord and the curve) because relaxing the patches was not enough.
+    pub damped_curves: usize,
+    /// Quads still invalid at the end (0 unless the input defeats both remedies).
+    pub invalid_left: usize,
+}
+
+/// The curve piece an adapted M edge follows, in the edge's direction, and how much of its
+/// G' edge's curve is kept (1 = the curve, 0 = the straight edge).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeCurve {
+    /// The M edge.
+    pub edge: u32,
+    /// The G' edge it lies on.
+    pub graph_edge: u32,
+    /// The piece's parameters on the G' edge's curve, in the M edge's direction.
+    pub parameters: [f64; 2],
+    /// The exact sub-curve of the G' edge's fitted curve.
+    pub curve: CubicBezier,
+    /// The straight piece's ends (the DT' vertices, on the straight G' edge).
+    pub chord: [Point; 2],
+    /// The share of the curve's bulge kept (that of its G' edge).
+    pub weight: f64,
+}
+
+/// Moves the control points of every M edge on a G' edge onto the exact piece of that edge's
+/// fitted curve (`curves[k]` for G' edge `k`), re-evaluates Q, and repairs quads that turned
+/// invalid: first the patch's inner control points are relaxed (Coons), then, if needed, the
+/// offending G' edges' bulge is halved (all their pieces, Steiner corners included), down to the
+/// straight edge, whose templates are always valid.
+pub fn adapt(
+    dt: &RegionTriangulation,
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    m: &ElementMesh,
+    net: &mut ControlNet,
+    q: &mut QuadMesh,
+) -> (AdaptReport, Vec<EdgeCurve>) {
+    let t = &dt.triangulation;
+    let mut report = AdaptReport::default();
+    let mut adapted = Vec::new();
+    let mut curve_of_edge = vec![NONE; m.edges.len()];
+    let mut pieces: Vec<Vec<u32>> = vec![Vec::new(); g.edges().len()];
+    let parameter = curve_parameters(dt, g, curves);
+    // The G' edge a Steiner vertex lies on: its move onto the curve affects every element
+    // around it, not only those with a side on the curve.
+    let mut curve_of_vertex = vec![NONE; t.num_vertices()];
+    for (e, &h) in m.edges.iter().enumerate() {
+        let Some((k, _)) = dt.graph_edge(g, h) else {
+            continue;
+        };
+        let Some(&curve) = curves.get(k as usize) else {
+            continue;
+        };
+        let (u0, u1) = (
+            parameter[t.origin(h).index()],
+            parameter[t.destination(h).index()],
+        );
+        let (u0, u1) = if dt.graph_vertex[t.origin(h).index()] != NONE
+            || dt.graph_vertex[t.destination(h).index()] != NONE
+        {
+            // A G' vertex: its parameter is 0 or 1 according to the end it is.
+            let ends = g.edges()[k as usize].ends;
+            let at = |v: imesh_geom::VertexId, u: f64| match dt.graph_vertex[v.index()] {
+                x if x == ends[0] => 0.0,
+                x if x == ends[1] => 1.0,
+                _ => u,
+            };
+            (at(t.origin(h), u0), at(t.destination(h), u1))
+        } else {
+            (u0, u1)
+        };
+        if u0 == u1 {
+            continue;
+        }
+        curve_of_edge[e] = adapted.len() as u32;
+        pieces[k as usize].push(adapted.len() as u32);
+        for v in [t.origin(h), t.destination(h)] {
+            if dt.graph_vertex[v.index()] == NONE {
+                curve_of_vertex[v.index()] = k;
+            }
+        }
+        adapted.push(EdgeCurve {
+            edge: e as u32,
+            graph_edge: k,
+            parameters: [u0, u1],
+            curve: piece_of(&curve, u0, u1),
+            chord: [t.point(t.origin(h)), t.point(t.destination(h))],
+            weight: 1.0,
+        });
+    }
+    for ec in &adapted {
+        place(dt, m, net, ec);
+    }
+    report.adapted_edges = adapted.len();
+    // Only the elements with a moved corner or a curved side change.
+    let mut touched = vec![false; m.elements.len()];
+    for (index, element) in m.elements.iter().enumerate() {
+        let moved = element
+            .corners()
+            .iter()
+            .any(|&v| curve_of_vertex[v as usize] != NONE);
+        let curved = (0..m.side_count(index))
+            .any(|side| curve_of_edge[m.side_edge(index, side).0 as usize] != NONE);
+        if moved || curved {
+            touched[index] = true;
+            q.evaluate_element(m, net, index);
+        }
+    }
+    let invalid = |q: &QuadMesh, index: usize| q.element_quads(index).any(|x| !q.is_valid(x));
+    let mut bad: Vec<usize> = (0..m.elements.len())
+        .filter(|&i| touched[i] && invalid(q, i))
+        .collect();
+    // Per-round stamps: a G' edge is damped at most once a round, an element listed once.
+    let mut curve_round = vec![0u32; g.edges().len()];
+    let mut element_round = vec![0u32; m.elements.len()];
+    let mut relaxed = vec![false; m.elements.len()];
+    let mut damped = vec![false; g.edges().len()];
+    let mut weight = vec![1.0f64; g.edges().len()];
+    for round in 1..=40u32 {
+        if bad.is_empty() {
+            break;
+        }
+        for &index in &bad {
+            net.relax_inner(&m.elements[index], index);
+            q.evaluate_element(m, net, index);
+            relaxed[index] = true;
+        }
+        let mut next = Vec::new();
+        let still: Vec<usize> = bad.iter().copied().filter(|&i| invalid(q, i)).collect();
+        for index in still {
+            let element = &m.elements[index];
+            let sides = (0..m.side_count(index)).filter_map(|side| {
+                let c = curve_of_edge[m.side_edge(index, side).0 as usize];
+                (c != NONE).then(|| adapted[c as usize].graph_edge)
+            });
+            let corners = element
+                .corners()
+                .iter()
+                .map(|&v| curve_of_vertex[v as usize])
+                .filter(|&k| k != NONE);
+            let touching: Vec<u32> = sides.chain(corners).collect();
+            for k in touching {
+                let k = k as usize;
+                if weight[k] == 0.0 || curve_round[k] == round {
+                    continue;
+                }
+                curve_round[k] = round;
+                weight[k] = if weight[k] > 1.0 / 16.0 {
+                    weight[k] / 2.0
+                } else {
+                    0.0
+                };
+                damped[k] = true;
+                for &p in &pieces[k] {
+                    let ec = &mut adapted[p as usize];
+                    ec.weight = weight[k];
+                    place(dt, m, net, ec);
+                    let h = m.edges[ec.edge as usize];
+                    // The elements on both sides, and all around its moved (Steiner) corners.
+                    let around = |v: imesh_geom::VertexId| {
+                        (dt.graph_vertex[v.index()] == NONE)
+                            .then(|| t.vertex_triangles(v))
+                            .into_iter()
+                            .flatten()
+                    };
+                    let sides = [t.triangle_of(h), t.triangle_of(t.twin(h))];
+                    for f in sides
+                        .into_iter()
+                        .chain(around(t.origin(h)))
+                        .chain(around(t.destination(h)))
+                    {
+                        if let Some(&el) = m.element_of_triangle.get(f.index()) {
+                            if el != NONE && element_round[el as usize] != round {
+                                element_round[el as usize] = round;
+                                next.push(el as usize);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // Moved corners change the neighbours' vertices too: re-evaluate before the next check.
+        for &index in &next {
+            q.evaluate_element(m, net, index);
+        }
+        bad = next;
+    }
+    report.relaxed_patches = relaxed.iter().filter(|&&r| r).count();
+    report.damped_curves = damped.iter().filter(|&&d| d).count();
+    report.invalid_left = (0..q.quads.len()).filter(|&x| !q.is_valid(x)).count();
+    (report, adapted)
+}
+
+/// The curve parameter of every Steiner vertex on a G' edge: that of its closest point on the
+/// edge's fitted curve, so that adaptation moves it across the curve rather than along it (the
+/// curve's parameter is not arc length, and the straight edge's parameter can be pixels away
+/// along a long curve). Where the projections of a G' edge's vertices would not run in order,
+/// that edge keeps the straight parameters.
+fn curve_parameters(dt: &RegionTriangulation, g: &CurveGraph, curves: &[CubicBezier]) -> Vec<f64> {
+    let t = &dt.triangulation;
+    let mut parameter = vec![0.0; t.num_vertices()];
+    for s in 0..t.num_segments() {
+        let Some(&k) = dt.segment_edge.get(s) else {
+            continue;
+        };
+        let Some(curve) = curves.get(k as usize) else {
+            continue;
+        };
+        let chain = dt.segment_pieces(imesh_geom::SegmentId(s as u32));
+        let straight: Vec<f64> = chain.iter().map(|&v| dt.edge_parameter(g, k, v)).collect();
+        let mut projected: Vec<f64> = chain
+            .iter()
+            .zip(&straight)
+            .map(|(&v, &u)| curve.closest_parameter(t.point(v), u))
+            .collect();
+        let n = chain.len();
+        if n >= 2 {
+            // The ends are the curve's ends, whichever way the segment was inserted.
+            let (first, last) = (straight[0], straight[n - 1]);
+            projected[0] = first.round();
+            projected[n - 1] = last.round();
+        }
+        let increasing = straight.first() <= straight.last();
+        let ordered = projected
+            .windows(2)
+            .all(|w| if increasing { w[0] < w[1] } else { w[0] > w[1] });
+        let chosen = if ordered { &projected } else { &straight };
+        for (&v, &u) in chain.iter().zip(chosen) {
+            parameter[v.index()] = u;
+        }
+    }
+    parameter
+}
+
+/// The piece of `curve` between parameters `u0` and `u1`, running from `u0` to `u1`.
+fn piece_of(curve: &CubicBezier, u0: f64, u1: f64) -> CubicBezier {
+    if u0 < u1 {
+        curve.sub_curve(u0, u1)
+    } else {
+        let c = curve.sub_curve(u1, u0).control;
+        CubicBezier::new([c[3], c[2], c[1], c[0]])
+    }
+}
+
+/// Sets the control points of an adapted M edge: its curve piece blended with the straight
+/// piece between the same parameters of the G' edge, by the edge's weight.
+fn place(dt: &RegionTriangulation, m: &ElementMesh, net: &mut ControlNet, ec: &EdgeCurve) {
+    let t = &dt.triangulation;
+    let h = m.edges[ec.edge as usize];
+    let (a, b) = (t.origin(h), t.destination(h));
+    let blended = blend(ec);
+    let inner = net.edge_inner(ec.edge);
+    net.points[a.index()] = blended[0];
+    net.points[b.index()] = blended[3];
+    net.points[inner[0] as usize] = blended[1];
+    net.points[inner[1] as usize] = blended[2];
+}
+
+/// The control points of `ec` as the mesh has them.
+fn blend(ec: &EdgeCurve) -> [Point; 4] {
+    let c = ec.curve.control;
+    if ec.weight == 1.0 {
+        return c;
+    }
+    // The straight piece between the DT' vertices: the same for both pieces at a Steiner
+    // vertex, as is the curve point, so the blended corner is shared exactly.
+    let chord = ec.chord;
+    let w = ec.weight;
+    let straight = CubicBezier::segment(chord[0], chord[1]).control;
+    [0, 1, 2, 3].map(|i| straight[i] + (c[i] - straight[i]) * w)
+}
+
+/// The point at parameter `s` of an adapted edge as the mesh has it.
+pub fn edge_point(edge: &EdgeCurve, s: f64) -> Point {
+    CubicBezier::new(blend(edge)).eval(s)
+}

@@ -1,0 +1,316 @@
+//! Pairing triangles of DT' into strictly convex quads: the mixed mesh M (DESIGN.md §2, step 7).
+
+use imesh_geom::predicates::orient2d;
+use imesh_geom::{HalfEdgeId, Point, TriangleId, Triangulation};
+
+use crate::dt::NONE;
+
+/// How triangles are paired.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Pairing {
+    /// The paper's triquad: unconstrained edges longest first; an edge whose two triangles are
+    /// both free and form a strictly convex quad pairs them.
+    #[default]
+    Greedy,
+    /// Best quads first (by their worst corner), then augmenting paths that re-pair neighbours so
+    /// that more triangles find a partner: fewer triangles left, better quads.
+    Matching,
+}
+
+/// One element of M: a triangle or a quad of DT' vertices, counter-clockwise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Element {
+    /// A triangle left unpaired.
+    Triangle([u32; 3]),
+    /// Two triangles paired across their common edge.
+    Quad([u32; 4]),
+}
+
+impl Element {
+    /// The corner vertices, counter-clockwise.
+    pub fn corners(&self) -> &[u32] {
+        match self {
+            Element::Triangle(c) => c,
+            Element::Quad(c) => c,
+        }
+    }
+}
+
+/// M: the elements of a pairing, with their edges numbered so that neighbours share them.
+#[derive(Clone, Debug)]
+pub struct ElementMesh {
+    /// The elements.
+    pub elements: Vec<Element>,
+    /// The region label of each element.
+    pub labels: Vec<u32>,
+    /// For each element, per side `i` (from corner `i` to corner `i + 1`): the DT' half-edge on
+    /// that side. A side's M edge is [`ElementMesh::edge_of`] that half-edge.
+    pub sides: Vec<[HalfEdgeId; 4]>,
+    /// The M edge of each DT' half-edge slot ([`NONE`] for a pairing diagonal or a ghost).
+    edge_of_half: Vec<u32>,
+    /// The canonical half-edge of each M edge (its direction is the edge's direction).
+    pub edges: Vec<HalfEdgeId>,
+    /// Triangles left unpaired.
+    pub unpaired: usize,
+    /// The element each DT' triangle slot belongs to ([`NONE`] for a ghost or dead slot).
+    pub element_of_triangle: Vec<u32>,
+}
+
+impl ElementMesh {
+    /// Pairs the triangles of `t` by `method`.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// use imesh_quad::{ElementMesh, Pairing};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(3.0, 0.0), Point::new(3.0, 2.0), Point::new(0.0, 2.0)];
+    /// let (t, _) = Triangulation::from_points(&pts).unwrap();
+    /// let m = ElementMesh::pair(&t, Pairing::Greedy);
+    /// assert_eq!((m.elements.len(), m.unpaired), (1, 0)); // the two triangles make the rectangle
+    /// ```
+    pub fn pair(t: &Triangulation, method: Pairing) -> Self {
+        let partner = match method {
+            Pairing::Greedy => greedy(t),
+            Pairing::Matching => matching(t),
+        };
+        Self::from_partners(t, &partner)
+    }
+
+    /// The M edge on `side` of element `element`, and whether the element walks it in the
+    /// edge's own direction.
+    pub fn side_edge(&self, element: usize, side: usize) -> (u32, bool) {
+        let h = self.sides[element][side];
+        let e = self.edge_of_half[h.index()];
+        (e, self.edges[e as usize] == h)
+    }
+
+    /// The M edge of DT' half-edge `h` (either direction), or [`NONE`] for a pairing diagonal.
+    pub fn edge_of(&self, h: HalfEdgeId) -> u32 {
+        self.edge_of_half[h.index()]
+    }
+
+    /// The number of sides of element `element` (3 or 4).
+    pub fn side_count(&self, element: usize) -> usize {
+        self.elements[element].corners().len()
+    }
+
+    fn from_partners(t: &Triangulation, partner: &[u32]) -> Self {
+        let slots = t.num_triangle_slots();
+        let mut elements = Vec::new();
+        let mut labels = Vec::new();
+        let mut sides = Vec::new();
+        let mut unpaired = 0;
+        let mut diagonal = vec![false; 3 * slots];
+        let mut element_of_triangle = vec![NONE; slots];
+        for f in t.triangles() {
+            let p = partner[f.index()];
+            if p != NONE && (p as usize) < f.index() {
+                continue; // the pair is emitted from its first triangle
+            }
+            let e = t.triangle_edges(f);
+            element_of_triangle[f.index()] = elements.len() as u32;
+            if p != NONE {
+                element_of_triangle[p as usize] = elements.len() as u32;
+            }
+            if p == NONE {
+                unpaired += 1;
+                elements.push(Element::Triangle(e.map(|h| t.origin(h).index() as u32)));
+                sides.push([e[0], e[1], e[2], e[2]]);
+            } else {
+                // The shared half-edge a → b in f, its twin b → a in the partner (b, a, d):
+                // the quad is a, d, b, c.
+                let h = e
+                    .into_iter()
+                    .find(|&h| t.neighbour(h).map(|n| n.index() as u32) == Some(p))
+                    .unwrap_or(e[0]);
+                let twin = t.twin(h);
+                let (h1, h2) = (t.next(h), t.prev(h)); // b → c, c → a
+                let (g1, g2) = (t.next(twin), t.prev(twin)); // a → d, d → b
+                diagonal[h.index()] = true;
+                diagonal[twin.index()] = true;
+                let v = |x: HalfEdgeId| t.origin(x).index() as u32;
+                elements.push(Element::Quad([v(g1), v(g2), v(h1), v(h2)]));
+                sides.push([g1, g2, h1, h2]);
+            }
+            labels.push(t.label(f));
+        }
+        let mut edge_of_half = vec![NONE; 3 * slots];
+        let mut edges = Vec::new();
+        for h in t.edges() {
+            if diagonal[h.index()] {
+                continue;
+            }
+            edge_of_half[h.index()] = edges.len() as u32;
+            edge_of_half[t.twin(h).index()] = edges.len() as u32;
+            edges.push(h);
+        }
+        Self {
+            elements,
+            labels,
+            sides,
+            edge_of_half,
+            edges,
+            unpaired,
+            element_of_triangle,
+        }
+    }
+}
+
+/// The quad `a, d, b, c` made by the triangle of `h` (a → b → c) and its neighbour across `h`
+/// (b → a → d), if both are real triangles of the same label across an unconstrained edge.
+fn quad_across(t: &Triangulation, h: HalfEdgeId) -> Option<[Point; 4]> {
+    if t.is_constrained(h) {
+        return None;
+    }
+    let f = t.triangle_of(h);
+    let n = t.neighbour(h)?;
+    if t.label(f) != t.label(n) {
+        return None;
+    }
+    let twin = t.twin(h);
+    let p = |x: HalfEdgeId| t.point(t.origin(x));
+    Some([p(t.next(twin)), p(t.prev(twin)), p(t.next(h)), p(t.prev(h))])
+}
+
+/// True when the quad turns strictly left at every corner (exact).
+fn strictly_convex(q: &[Point; 4]) -> bool {
+    (0..4).all(|i| orient2d(q[(i + 3) % 4], q[i], q[(i + 1) % 4]) > 0.0)
+}
+
+/// The quad's worst corner: the smallest sine of its four angles (its scaled Jacobian).
+fn worst_corner(q: &[Point; 4]) -> f64 {
+    (0..4)
+        .map(|i| {
+            let (a, b) = (q[(i + 1) % 4] - q[i], q[(i + 3) % 4] - q[i]);
+            let cross = a.x * b.y - a.y * b.x;
+            cross / ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y)).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn pair_up(partner: &mut [u32], f: TriangleId, n: TriangleId) {
+    partner[f.index()] = n.index() as u32;
+    partner[n.index()] = f.index() as u32;
+}
+
+/// The paper's triquad. A sort stands in for the max-heap: the keys never change.
+fn greedy(t: &Triangulation) -> Vec<u32> {
+    let mut candidates: Vec<(f64, HalfEdgeId)> = t
+        .edges()
+        .filter(|&h| quad_across(t, h).is_some())
+        .map(|h| {
+            let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+            (a.distance_squared(b), h)
+        })
+        .collect();
+    candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.index().cmp(&y.1.index())));
+    let mut partner = vec![NONE; t.num_triangle_slots()];
+    let mut marked = vec![false; 3 * t.num_triangle_slots()];
+    for (_, h) in candidates {
+        if marked[h.index()] {
+            continue;
+        }
+        let (f, Some(n)) = (t.triangle_of(h), t.neighbour(h)) else {
+            continue;
+        };
+        if partner[f.index()] != NONE || partner[n.index()] != NONE {
+            continue;
+        }
+        let Some(q) = quad_across(t, h) else { continue };
+        if !strictly_convex(&q) {
+            continue;
+        }
+        pair_up(&mut partner, f, n);
+        let twin = t.twin(h);
+        for x in [t.next(h), t.prev(h), t.next(twin), t.prev(twin)] {
+            marked[x.index()] = true;
+            marked[t.twin(x).index()] = true;
+        }
+    }
+    partner
+}
+
+/// Quads worse than this (a corner angle within about 10° of flat) are not formed by the
+/// matching: the templates would turn them into near-degenerate quads.
+const MIN_MATCHING_CORNER: f64 = 0.17;
+
+/// How many re-pairings an augmenting path may make.
+const MAX_AUGMENTING_DEPTH: usize = 8;
+
+/// Best quads first, then augmenting paths for the triangles left.
+fn matching(t: &Triangulation) -> Vec<u32> {
+    let good = |h: HalfEdgeId| {
+        quad_across(t, h)
+            .filter(strictly_convex)
+            .map(|q| worst_corner(&q))
+            .filter(|&w| w >= MIN_MATCHING_CORNER)
+    };
+    let mut candidates: Vec<(f64, HalfEdgeId)> =
+        t.edges().filter_map(|h| good(h).map(|w| (w, h))).collect();
+    candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.index().cmp(&y.1.index())));
+    let mut partner = vec![NONE; t.num_triangle_slots()];
+    for &(_, h) in &candidates {
+        let (f, Some(n)) = (t.triangle_of(h), t.neighbour(h)) else {
+            continue;
+        };
+        if partner[f.index()] == NONE && partner[n.index()] == NONE {
+            pair_up(&mut partner, f, n);
+        }
+    }
+    // Augmenting paths: from a free triangle, step to a neighbour it could pair with; if that one
+    // is paired, continue from its partner; a free triangle at the end flips the whole path.
+    let mut mark = vec![0u32; t.num_triangle_slots()];
+    let mut round = 0;
+    let free: Vec<TriangleId> = t
+        .triangles()
+        .filter(|f| partner[f.index()] == NONE)
+        .collect();
+    // For a triangle reached as the neighbour of a free-side triangle: that triangle.
+    let mut parent = vec![NONE; t.num_triangle_slots()];
+    let mut queue = std::collections::VecDeque::new();
+    for start in free {
+        if partner[start.index()] != NONE {
+            continue;
+        }
+        round += 1;
+        queue.clear();
+        queue.push_back((start, 0usize));
+        mark[start.index()] = round;
+        let mut end = None;
+        'search: while let Some((f, depth)) = queue.pop_front() {
+            if depth >= MAX_AUGMENTING_DEPTH {
+                continue;
+            }
+            for h in t.triangle_edges(f) {
+                let Some(n) = t.neighbour(h) else { continue };
+                if mark[n.index()] == round || good(h).is_none() {
+                    continue;
+                }
+                mark[n.index()] = round;
+                parent[n.index()] = f.index() as u32;
+                let p = partner[n.index()];
+                if p == NONE {
+                    end = Some(n);
+                    break 'search;
+                }
+                if mark[p as usize] != round {
+                    mark[p as usize] = round;
+                    queue.push_back((TriangleId::new(p), depth + 1));
+                }
+            }
+        }
+        // Flip the path back from its free end: each free-side triangle takes the neighbour the
+        // search reached from it, and its old partner is re-paired the same way, up to `start`.
+        let Some(mut n) = end else { continue };
+        loop {
+            let f = parent[n.index()];
+            let old = partner[f as usize];
+            partner[f as usize] = n.index() as u32;
+            partner[n.index()] = f;
+            if f == start.index() as u32 || old == NONE {
+                break;
+            }
+            n = TriangleId::new(old);
+        }
+    }
+    partner
+}

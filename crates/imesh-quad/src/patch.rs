@@ -1,0 +1,266 @@
+//! Bézier patches over the elements of M: a cubic triangular patch (10 control points) per
+//! triangle, a bicubic patch (16) per quad, all in one control net so that neighbouring patches
+//! share their edge control points (DESIGN.md §2, step 9; the paper's section V-C).
+//!
+//! Control point numbering in the net: first one per DT' vertex (the corners), then two per M
+//! edge (its inner control points, at 1/3 and 2/3 along the edge's own direction), then each
+//! element's inner ones (1 for a triangle, 4 for a quad).
+
+use imesh_geom::{Point, Triangulation};
+
+use crate::pairing::{Element, ElementMesh};
+
+/// Triangle patch slots as `(a, b)`: powers of the weights of corners 1 and 2 (corner 0 has
+/// `3 − a − b`). Slot 5, `(1, 1)`, is the inner control point.
+pub const TRIANGLE_SLOTS: [(u8, u8); 10] = [
+    (0, 0),
+    (1, 0),
+    (2, 0),
+    (3, 0),
+    (0, 1),
+    (1, 1),
+    (2, 1),
+    (0, 2),
+    (1, 2),
+    (0, 3),
+];
+
+/// Triangle patch slots along each side, from its first corner to the next.
+const TRIANGLE_SIDES: [[usize; 4]; 3] = [[0, 1, 2, 3], [3, 6, 8, 9], [9, 7, 4, 0]];
+
+/// Quad patch slot of control point `(i, j)` is `i + 4 j`; slots along each side.
+const QUAD_SIDES: [[usize; 4]; 4] = [
+    [0, 1, 2, 3],
+    [3, 7, 11, 15],
+    [15, 14, 13, 12],
+    [12, 8, 4, 0],
+];
+
+/// The inner slots of a quad patch.
+const QUAD_INNER: [usize; 4] = [5, 6, 9, 10];
+
+/// The control net of every patch of M.
+#[derive(Clone, Debug)]
+pub struct ControlNet {
+    /// All control points.
+    pub points: Vec<Point>,
+    /// Per element, its control points' indices into `points` by slot (triangles use 10 slots in
+    /// [`TRIANGLE_SLOTS`] order; quads 16, slot `i + 4 j`).
+    pub patches: Vec<[u32; 16]>,
+    /// Index of the first inner control point of each M edge (`+ 1` is the second).
+    edge_base: u32,
+}
+
+impl ControlNet {
+    /// The affine (triangles) and bilinear (quads) patches of M: control points at the images of
+    /// a uniform grid, so that every patch is exactly its straight element.
+    pub fn straight(t: &Triangulation, m: &ElementMesh) -> Self {
+        let nv = t.num_vertices();
+        let mut points: Vec<Point> = t.points().to_vec();
+        points.truncate(nv);
+        let edge_base = points.len() as u32;
+        for &h in &m.edges {
+            let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+            points.push(a + (b - a) * (1.0 / 3.0));
+            points.push(a + (b - a) * (2.0 / 3.0));
+        }
+        let mut patches = Vec::with_capacity(m.elements.len());
+        for (k, element) in m.elements.iter().enumerate() {
+            let mut slots = [u32::MAX; 16];
+            let corners = element.corners();
+            let sides: &[[usize; 4]] = match element {
+                Element::Triangle(_) => &TRIANGLE_SIDES,
+                Element::Quad(_) => &QUAD_SIDES,
+            };
+            for (side, along) in sides.iter().enumerate() {
+                let (e, forward) = m.side_edge(k, side);
+                let inner = [edge_base + 2 * e, edge_base + 2 * e + 1];
+                let (first, second) = if forward {
+                    (inner[0], inner[1])
+                } else {
+                    (inner[1], inner[0])
+                };
+                slots[along[0]] = corners[side];
+                slots[along[1]] = first;
+                slots[along[2]] = second;
+            }
+            match element {
+                Element::Triangle(c) => {
+                    let p = c.map(|v| points[v as usize]);
+                    slots[5] = points.len() as u32;
+                    points.push((p[0] + p[1] + p[2]) * (1.0 / 3.0));
+                }
+                Element::Quad(c) => {
+                    let p = c.map(|v| points[v as usize]);
+                    for slot in QUAD_INNER {
+                        let (i, j) = ((slot % 4) as f64 / 3.0, (slot / 4) as f64 / 3.0);
+                        slots[slot] = points.len() as u32;
+                        points.push(bilinear(&p, i, j));
+                    }
+                }
+            }
+            patches.push(slots);
+        }
+        Self {
+            points,
+            patches,
+            edge_base,
+        }
+    }
+
+    /// The four control points along side `side` of element `k`'s patch, from the side's first
+    /// corner.
+    pub fn side_points(&self, element: &Element, k: usize, side: usize) -> [Point; 4] {
+        let along = match element {
+            Element::Triangle(_) => TRIANGLE_SIDES[side],
+            Element::Quad(_) => QUAD_SIDES[side],
+        };
+        along.map(|slot| self.points[self.patches[k][slot] as usize])
+    }
+
+    /// The point of element `k`'s patch for the basis `weights`, exact on axis-parallel
+    /// straight sides: a point on side `side` whose four control points share a coordinate gets
+    /// that coordinate exactly (so that the domain border and pixel-aligned boundaries stay
+    /// exact, whatever the rounding of the patch sum).
+    pub fn eval_on_side(
+        &self,
+        element: &Element,
+        k: usize,
+        weights: &[f64; 16],
+        side: usize,
+    ) -> Point {
+        let mut p = self.eval_weights(k, weights);
+        let c = self.side_points(element, k, side);
+        if c.iter().all(|q| q.x == c[0].x) {
+            p.x = c[0].x;
+        }
+        if c.iter().all(|q| q.y == c[0].y) {
+            p.y = c[0].y;
+        }
+        p
+    }
+
+    /// The inner control points of M edge `e` (at 1/3 and 2/3 along its direction).
+    pub fn edge_inner(&self, e: u32) -> [u32; 2] {
+        [self.edge_base + 2 * e, self.edge_base + 2 * e + 1]
+    }
+
+    /// The point of element `k`'s patch for precomputed basis weights (see [`basis`]).
+    pub fn eval_weights(&self, k: usize, weights: &[f64; 16]) -> Point {
+        let slots = &self.patches[k];
+        let (mut x, mut y) = (0.0, 0.0);
+        for (&slot, &w) in slots.iter().zip(weights) {
+            if w != 0.0 {
+                let p = self.points[slot as usize];
+                x += w * p.x;
+                y += w * p.y;
+            }
+        }
+        Point::new(x, y)
+    }
+
+    /// The point of element `k`'s patch at canonical coordinates `uv`.
+    pub fn eval(&self, element: &Element, k: usize, uv: [f64; 2]) -> Point {
+        let slots = &self.patches[k];
+        let p = |slot: usize| self.points[slots[slot] as usize];
+        match element {
+            Element::Triangle(_) => {
+                let (l1, l2) = (uv[0], uv[1]);
+                let l0 = 1.0 - l1 - l2;
+                let powers = |x: f64| [1.0, x, x * x, x * x * x];
+                let (p0, p1, p2) = (powers(l0), powers(l1), powers(l2));
+                let mut sum = Point::new(0.0, 0.0);
+                for (slot, &(a, b)) in TRIANGLE_SLOTS.iter().enumerate() {
+                    let (a, b) = (a as usize, b as usize);
+                    let w = TRIANGLE_COEFFICIENTS[slot] * p0[3 - a - b] * p1[a] * p2[b];
+                    sum = sum + p(slot) * w;
+                }
+                sum
+            }
+            Element::Quad(_) => {
+                let (bs, bt) = (bernstein3(uv[0]), bernstein3(uv[1]));
+                let mut sum = Point::new(0.0, 0.0);
+                for (j, wj) in bt.iter().enumerate() {
+                    for (i, wi) in bs.iter().enumerate() {
+                        sum = sum + p(i + 4 * j) * (wi * wj);
+                    }
+                }
+                sum
+            }
+        }
+    }
+
+    /// Resets element `k`'s inner control points from its boundary: the discrete Coons patch for
+    /// a quad, the quadratic-precision blend for a triangle. Both give back the straight patch of
+    /// straight boundaries and follow curved ones smoothly.
+    pub fn relax_inner(&mut self, element: &Element, k: usize) {
+        let slots = self.patches[k];
+        let points = &self.points;
+        let p = |slot: usize| points[slots[slot] as usize];
+        let mut inner = [(0usize, Point::new(0.0, 0.0)); 4];
+        let count = match element {
+            Element::Triangle(_) => {
+                let edges = [1, 2, 6, 8, 7, 4]
+                    .iter()
+                    .fold(Point::new(0.0, 0.0), |s, &x| s + p(x));
+                let corners = p(0) + p(3) + p(9);
+                inner[0] = (5, edges * 0.25 - corners * (1.0 / 6.0));
+                1
+            }
+            Element::Quad(_) => {
+                for (n, slot) in QUAD_INNER.into_iter().enumerate() {
+                    let (i, j) = (slot % 4, slot / 4);
+                    let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
+                    let ruled_s = p(4 * j) * (1.0 - u) + p(3 + 4 * j) * u;
+                    let ruled_t = p(i) * (1.0 - v) + p(i + 12) * v;
+                    let corners = bilinear(&[p(0), p(3), p(15), p(12)], u, v);
+                    inner[n] = (slot, ruled_s + ruled_t - corners);
+                }
+                4
+            }
+        };
+        for &(slot, point) in &inner[..count] {
+            self.points[slots[slot] as usize] = point;
+        }
+    }
+}
+
+/// The Bernstein basis of a triangle (10 slots, the rest 0) or quad (16 slots) patch at
+/// canonical coordinates `uv`: the weights of the control points in the patch's point there.
+pub fn basis(quad: bool, uv: [f64; 2]) -> [f64; 16] {
+    let mut w = [0.0; 16];
+    if quad {
+        let (bs, bt) = (bernstein3(uv[0]), bernstein3(uv[1]));
+        for j in 0..4 {
+            for i in 0..4 {
+                w[i + 4 * j] = bs[i] * bt[j];
+            }
+        }
+    } else {
+        let (l1, l2) = (uv[0], uv[1]);
+        let powers = |x: f64| [1.0, x, x * x, x * x * x];
+        let (p0, p1, p2) = (powers(1.0 - l1 - l2), powers(l1), powers(l2));
+        for (slot, &(a, b)) in TRIANGLE_SLOTS.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            w[slot] = TRIANGLE_COEFFICIENTS[slot] * p0[3 - a - b] * p1[a] * p2[b];
+        }
+    }
+    w
+}
+
+/// The trinomial coefficients `3! / (i! a! b!)` of the triangle slots.
+const TRIANGLE_COEFFICIENTS: [f64; 10] = [1.0, 3.0, 3.0, 1.0, 3.0, 6.0, 3.0, 3.0, 3.0, 1.0];
+
+/// The cubic Bernstein polynomials at `t`.
+fn bernstein3(t: f64) -> [f64; 4] {
+    let s = 1.0 - t;
+    [s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t]
+}
+
+/// The bilinear map of the quad `p` (counter-clockwise from `(0, 0)`) at `(u, v)`.
+pub(crate) fn bilinear(p: &[Point; 4], u: f64, v: f64) -> Point {
+    p[0] * ((1.0 - u) * (1.0 - v))
+        + p[1] * (u * (1.0 - v))
+        + p[2] * (u * v)
+        + p[3] * ((1.0 - u) * v)
+}

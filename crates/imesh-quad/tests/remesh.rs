@@ -1,0 +1,380 @@
+//! The quad stage on the fixtures' simplified boundary graphs.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
+use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
+use imesh_geom::Point;
+use imesh_quad::{
+    remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
+};
+use imesh_segment::{SampleOptions, SegmentedMesh};
+
+const TOLERANCE: f64 = 2.0;
+
+fn fixture(name: &str) -> LabelGrid {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name);
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    if name.contains("labels") {
+        return label_map(&image, 256).unwrap();
+    }
+    let grey = luminance(&image);
+    threshold(&grey, &multi_otsu_levels(&grey, 3))
+}
+
+/// G (the Imesh c-edges) and G' at `TOLERANCE`, with G' edges' fitted curves.
+struct Curves {
+    original: CurveGraph,
+    simplified: imesh_curves::Simplification,
+    fits: imesh_curves::FitReport,
+    width: f64,
+    height: f64,
+}
+
+fn curves(grid: &LabelGrid) -> Curves {
+    let m = SegmentedMesh::from_grid(grid, &SampleOptions::default()).unwrap();
+    let edges = m
+        .c_edges
+        .iter()
+        .map(|e| GraphEdge {
+            ends: e.vertices.map(|v| v.index() as u32),
+            labels: e.labels,
+        })
+        .collect();
+    let mut original = CurveGraph::new(m.triangulation.points().to_vec(), edges).unwrap();
+    let (width, height) = (f64::from(grid.width()), f64::from(grid.height()));
+    original.pin_domain_corners(width, height);
+    let simplified = simplify(
+        &original,
+        &SimplifyOptions {
+            tolerance: TOLERANCE,
+        },
+    )
+    .unwrap();
+    let fits = fit_edges(&simplified, &original, &FitOptions::default());
+    Curves {
+        original,
+        simplified,
+        fits,
+        width,
+        height,
+    }
+}
+
+fn run(c: &Curves, options: &QuadOptions) -> Remesh {
+    let curves: Vec<_> = c.fits.fits.iter().map(|f| f.curve).collect();
+    remesh(&c.simplified.graph, &curves, options).unwrap()
+}
+
+/// Conforming, valid, exact area, labels from the parent: the invariants of DESIGN.md §3.
+fn check_mesh(r: &Remesh, c: &Curves, vertices: &[Point]) {
+    let q = &r.mesh;
+    // Every edge in one or two quads; edges in one quad only on the domain border.
+    let mut count: HashMap<(u32, u32), u32> = HashMap::new();
+    for quad in &q.quads {
+        for i in 0..4 {
+            let (a, b) = (quad[i], quad[(i + 1) % 4]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    for (&(a, b), &n) in &count {
+        assert!(n <= 2, "edge {a}-{b} in {n} quads");
+        if n == 1 {
+            let (p, r) = (vertices[a as usize], vertices[b as usize]);
+            let on_border = (p.x == 0.0 && r.x == 0.0)
+                || (p.y == 0.0 && r.y == 0.0)
+                || (p.x == c.width && r.x == c.width)
+                || (p.y == c.height && r.y == c.height);
+            assert!(on_border, "open edge {p:?}-{r:?} inside the domain");
+        }
+    }
+    // No unused or duplicate vertices.
+    let mut used = vec![false; vertices.len()];
+    q.quads
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
+    assert!(used.iter().all(|&u| u), "a vertex no quad uses");
+    let mut positions: Vec<(u64, u64)> = vertices
+        .iter()
+        .map(|p| (p.x.to_bits(), p.y.to_bits()))
+        .collect();
+    positions.sort_unstable();
+    positions.dedup();
+    assert_eq!(positions.len(), vertices.len(), "two vertices at one place");
+    // Valid quads and the exact area.
+    let mut area = 0.0;
+    for (k, quad) in q.quads.iter().enumerate() {
+        let p = quad.map(|v| vertices[v as usize]);
+        for i in 0..4 {
+            let o = imesh_geom::predicates::orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]);
+            assert!(
+                o > 0.0,
+                "quad {k} has a non-positive Jacobian at corner {i}"
+            );
+        }
+        area +=
+            0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y));
+        assert_eq!(q.labels[k], r.elements.labels[q.parents[k] as usize]);
+    }
+    let domain = c.width * c.height;
+    assert!(
+        (area - domain).abs() <= 1e-9 * domain,
+        "area {area} vs {domain}"
+    );
+}
+
+const FIXTURES: [&str; 3] = [
+    "pyvista-channels_z050_labels.png",
+    "stardist-mask2d_labels.png",
+    "skimage-coins.png",
+];
+
+#[test]
+fn fixtures_give_valid_conforming_quad_meshes_before_and_after_adaptation() {
+    for name in FIXTURES {
+        let c = curves(&fixture(name));
+        let r = run(&c, &QuadOptions::default());
+        assert!(!r.mesh.quads.is_empty());
+        check_mesh(&r, &c, &r.straight_vertices);
+        check_mesh(&r, &c, &r.mesh.vertices);
+        assert_eq!(r.adaptation.invalid_left, 0, "{name}: {:?}", r.adaptation);
+        assert!(r.adaptation.adapted_edges > 0);
+        eprintln!(
+            "{name}: {} quads, {} elements ({} triangles unpaired), {:?}",
+            r.mesh.quads.len(),
+            r.elements.elements.len(),
+            r.elements.unpaired,
+            r.adaptation
+        );
+    }
+}
+
+#[test]
+fn every_simplified_edge_is_a_union_of_quad_edges_before_adaptation() {
+    let c = curves(&fixture("skimage-coins.png"));
+    let r = run(&c, &QuadOptions::default());
+    let t = &r.dt.triangulation;
+    let g = &c.simplified.graph;
+    let mut quad_edges = std::collections::HashSet::new();
+    for quad in &r.mesh.quads {
+        for i in 0..4 {
+            let (a, b) = (quad[i], quad[(i + 1) % 4]);
+            quad_edges.insert((a.min(b), a.max(b)));
+        }
+    }
+    let mut covered = vec![0.0; g.edges().len()];
+    for e in 0..r.elements.edges.len() as u32 {
+        let Some((k, _)) = r.dt.graph_edge(g, r.elements.edges[e as usize]) else {
+            continue;
+        };
+        let [a, b] = g.edges()[k as usize].ends.map(|v| g.point(v));
+        let along = r.mesh.edge_vertices(t, &r.elements, e);
+        for w in along.windows(2) {
+            assert!(quad_edges.contains(&(w[0].min(w[1]), w[0].max(w[1]))));
+        }
+        let param = |v: u32| {
+            let p = r.straight_vertices[v as usize];
+            let ab = b - a;
+            // On the straight edge, to rounding.
+            let cross = (p.x - a.x) * ab.y - (p.y - a.y) * ab.x;
+            assert!(
+                cross.abs() <= 1e-9 * (ab.x * ab.x + ab.y * ab.y),
+                "off the edge by {cross}"
+            );
+            ((p.x - a.x) * ab.x + (p.y - a.y) * ab.y) / (ab.x * ab.x + ab.y * ab.y)
+        };
+        covered[k as usize] += (param(along[along.len() - 1]) - param(along[0])).abs();
+    }
+    for (k, total) in covered.iter().enumerate() {
+        assert!((total - 1.0).abs() < 1e-9, "G' edge {k} covered {total}");
+    }
+}
+
+#[test]
+fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
+    for name in FIXTURES {
+        let c = curves(&fixture(name));
+        let r = run(
+            &c,
+            &QuadOptions {
+                level: 2,
+                ..Default::default()
+            },
+        );
+        let t = &r.dt.triangulation;
+        let g = &c.simplified.graph;
+        let mut checked = 0;
+        for ec in r.edge_curves.iter().filter(|ec| ec.weight == 1.0) {
+            let k = ec.graph_edge as usize;
+            let curve = c.fits.fits[k].curve;
+            let along = r.mesh.edge_vertices(t, &r.elements, ec.edge);
+            let chain: Vec<Point> = c.simplified.chains[k]
+                .iter()
+                .map(|&v| c.original.point(v))
+                .collect();
+            let n = along.len() - 1;
+            for (i, &v) in along.iter().enumerate() {
+                let p = r.mesh.vertices[v as usize];
+                let [u0, u1] = ec.parameters;
+                let on_curve = curve.eval(u0 + (u1 - u0) * i as f64 / n as f64);
+                let d = p.distance_squared(on_curve).sqrt();
+                assert!(d < 1e-9, "{name}: vertex {v} is {d} px off its curve");
+                let to_chain = chain
+                    .windows(2)
+                    .map(|w| segment_distance(w[0], w[1], p))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    to_chain <= TOLERANCE + 1e-9,
+                    "{name}: {to_chain} px from the chain"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 0);
+        let _ = g;
+    }
+}
+
+fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
+    let ab = b - a;
+    let len2 = ab.x * ab.x + ab.y * ab.y;
+    let t = if len2 > 0.0 {
+        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    q.distance_squared(a + ab * t).sqrt()
+}
+
+#[test]
+fn template_level_k_gives_3k2_and_4k2_quads_per_element() {
+    let c = curves(&fixture("pyvista-channels_z050_labels.png"));
+    for k in 1..=3u32 {
+        let r = run(
+            &c,
+            &QuadOptions {
+                level: k,
+                ..Default::default()
+            },
+        );
+        let mut expected = 0;
+        for (index, element) in r.elements.elements.iter().enumerate() {
+            let want = match element {
+                Element::Triangle(_) => 3 * k * k,
+                Element::Quad(_) => 4 * k * k,
+            } as usize;
+            assert_eq!(r.mesh.element_quads(index).len(), want);
+            assert!(r
+                .mesh
+                .element_quads(index)
+                .all(|q| r.mesh.parents[q] == index as u32));
+            expected += want;
+        }
+        assert_eq!(r.mesh.quads.len(), expected);
+        check_mesh(&r, &c, &r.mesh.vertices);
+    }
+}
+
+#[test]
+fn every_vertex_is_its_holders_patches_at_its_canonical_coordinates() {
+    let c = curves(&fixture("stardist-mask2d_labels.png"));
+    let r = run(
+        &c,
+        &QuadOptions {
+            level: 2,
+            ..Default::default()
+        },
+    );
+    for v in 0..r.mesh.vertices.len() as u32 {
+        let holders = r.mesh.holders(v);
+        assert!(!holders.is_empty());
+        for h in holders {
+            let element = &r.elements.elements[h.element as usize];
+            let p = r.net.eval(element, h.element as usize, h.coords);
+            let q = r.mesh.vertices[v as usize];
+            assert!(
+                p.distance_squared(q).sqrt() < 1e-9,
+                "vertex {v}: {p:?} vs {q:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
+    for name in FIXTURES {
+        let c = curves(&fixture(name));
+        let dt =
+            imesh_quad::RegionTriangulation::new(&c.simplified.graph, &DensityOptions::default())
+                .unwrap();
+        let greedy = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+        let matching = ElementMesh::pair(&dt.triangulation, Pairing::Matching);
+        let total = dt.triangulation.num_triangles();
+        for m in [&greedy, &matching] {
+            let quads = m
+                .elements
+                .iter()
+                .filter(|e| matches!(e, Element::Quad(_)))
+                .count();
+            assert_eq!(2 * quads + m.unpaired, total);
+        }
+        eprintln!(
+            "{name}: {total} triangles, unpaired greedy {:.1} %, matching {:.1} %",
+            100.0 * greedy.unpaired as f64 / total as f64,
+            100.0 * matching.unpaired as f64 / total as f64
+        );
+        assert!(matching.unpaired < greedy.unpaired, "{name}");
+        let r = run(
+            &c,
+            &QuadOptions {
+                pairing: Pairing::Matching,
+                ..Default::default()
+            },
+        );
+        check_mesh(&r, &c, &r.mesh.vertices);
+    }
+}
+
+#[test]
+fn bad_options_are_typed_errors() {
+    let c = curves(&fixture("stardist-mask2d_labels.png"));
+    let curves: Vec<_> = c.fits.fits.iter().map(|f| f.curve).collect();
+    for level in [0, 9] {
+        let options = QuadOptions {
+            level,
+            ..Default::default()
+        };
+        assert_eq!(
+            remesh(&c.simplified.graph, &curves, &options).unwrap_err(),
+            QuadError::BadLevel { level }
+        );
+    }
+    assert!(matches!(
+        remesh(&c.simplified.graph, &curves[1..], &QuadOptions::default()),
+        Err(QuadError::CurveCount { .. })
+    ));
+    let empty = CurveGraph::new(vec![], vec![]).unwrap();
+    assert_eq!(
+        remesh(&empty, &[], &QuadOptions::default()).unwrap_err(),
+        QuadError::EmptyGraph
+    );
+    let density = DensityOptions {
+        min_angle_deg: 40.0,
+        ..Default::default()
+    };
+    assert!(matches!(
+        remesh(
+            &c.simplified.graph,
+            &curves,
+            &QuadOptions {
+                density,
+                ..Default::default()
+            }
+        ),
+        Err(QuadError::Geometry(_))
+    ));
+}
