@@ -1,9 +1,10 @@
 //! imesh: an image in, a segmented, simulation-ready mesh out.
 //!
-//! [`Pipeline`] composes the stages (classify → Imesh sampling and partition → quality triangle
-//! mesh → checks) and times each one; the `imesh` program is a thin command line over it. Quad
-//! output (templates, Bézier boundary fitting, optimisation) joins the pipeline as those crates
-//! land; today the pipeline gives the Imesh triangle mesh.
+//! [`Pipeline`] composes the stages and times each one; the `imesh` program is a thin command
+//! line over it. Quads (the default): classify → Imesh sampling and partition → curves
+//! (topology-preserving simplification, Bézier fitting) → DT' → pairing → templates → boundary
+//! adaptation → checks. Triangles (`elements = "tri"`): classify → Imesh sampling and partition →
+//! label-aware Ruppert refinement → checks. (Optimisation of the quads joins as it lands.)
 //!
 //! ```
 //! use imesh::{MeshOptions, Pipeline};
@@ -13,6 +14,7 @@
 //! let result = Pipeline::new(MeshOptions::default()).run_image(&image).unwrap();
 //! assert!(result.report.validation.valid);
 //! assert_eq!(result.report.counts.labels, 2);
+//! assert!(result.report.counts.quads > 0 && result.report.counts.triangles == 0);
 //! ```
 
 use std::path::Path;
@@ -20,9 +22,13 @@ use std::str::FromStr;
 use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
+use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
 use imesh_geom::{RefineOptions, StopReason};
 use imesh_io::SegmentedMeshData;
-use imesh_quality::{validate, Domain, Element, MeshView, TriangleQuality};
+use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
+use imesh_quality::{
+    validate, Domain, Element, MeshView, QuadQuality, Statistics, TriangleQuality,
+};
 use imesh_segment::{SampleOptions, SegmentedMesh};
 use serde::{Deserialize, Serialize};
 
@@ -32,8 +38,29 @@ use serde::{Deserialize, Serialize};
 pub enum Elements {
     /// The Imesh triangle mesh.
     Tri,
-    /// The all-quad mesh (not in this build yet).
+    /// The all-quad mesh.
     Quad,
+}
+
+/// How the quad stage pairs triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PairingMethod {
+    /// The paper's greedy triquad (longest edges first).
+    Greedy,
+    /// Best quads first, then augmenting paths: fewer triangles left.
+    Matching,
+}
+
+impl FromStr for PairingMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "greedy" => Ok(Self::Greedy),
+            "matching" => Ok(Self::Matching),
+            _ => Err(format!("unknown pairing {s:?}: use greedy or matching")),
+        }
+    }
 }
 
 impl FromStr for Elements {
@@ -56,12 +83,20 @@ pub struct MeshOptions {
     pub classify: String,
     /// Imesh error threshold t_e (smaller: more vertices, closer boundaries).
     pub te: f64,
-    /// Smallest angle of the triangle mesh, in degrees (at most 34).
-    pub min_angle: f64,
+    /// Smallest angle of the triangles, in degrees (at most 34): of the Imesh triangle mesh
+    /// (default 26.4°) or of DT' before pairing (default 20.7°).
+    pub min_angle: Option<f64>,
     /// Most points refinement may insert.
     pub max_steiner: Option<usize>,
-    /// Largest element area in square pixels, if any.
-    pub max_area: Option<f64>,
+    /// Largest element size in pixels (the side of the largest equilateral triangle allowed
+    /// before pairing or in the triangle mesh), if any.
+    pub max_size: Option<f64>,
+    /// Curve simplification tolerance in pixels (quads).
+    pub tolerance: f64,
+    /// Template level k: each triangle gives 3k² quads, each paired quad 4k² (1–8).
+    pub template_level: u32,
+    /// How triangles are paired into quads.
+    pub pairing: PairingMethod,
     /// Element kind.
     pub elements: Elements,
     /// Size of a pixel along x and y in the written mesh.
@@ -75,10 +110,13 @@ impl Default for MeshOptions {
         Self {
             classify: "auto".into(),
             te: 0.1,
-            min_angle: imesh_segment::DEFAULT_MIN_ANGLE,
+            min_angle: None,
             max_steiner: None,
-            max_area: None,
-            elements: Elements::Tri,
+            max_size: None,
+            tolerance: imesh_curves::DEFAULT_TOLERANCE,
+            template_level: 1,
+            pairing: PairingMethod::Matching,
+            elements: Elements::Quad,
             pixel_size: [1.0, 1.0],
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
         }
@@ -97,6 +135,12 @@ pub enum PipelineError {
     /// Sampling or refinement failed.
     #[error(transparent)]
     Segment(#[from] imesh_segment::SegmentError),
+    /// The curve stage refused its input.
+    #[error(transparent)]
+    Curves(#[from] imesh_curves::CurveError),
+    /// The quad stage refused its input.
+    #[error(transparent)]
+    Quads(#[from] imesh_quad::QuadError),
     /// The mesh broke an invariant (a bug: please report it with the image).
     #[error("the mesh is invalid ({0}); please report this with the image")]
     Invalid(String),
@@ -109,8 +153,12 @@ pub struct StageSeconds {
     pub classify: f64,
     /// Imesh sampling, partition and c-edges.
     pub sample: f64,
-    /// Quality refinement of the triangles.
+    /// Quality refinement of the triangles (triangle output).
     pub refine: f64,
+    /// Curve simplification and fitting (quads).
+    pub curves: f64,
+    /// DT', pairing, templates and adaptation (quads).
+    pub quads: f64,
     /// Invariant checks and quality measurement.
     pub check: f64,
     /// All stages.
@@ -134,10 +182,58 @@ pub struct Counts {
     pub refinement_points: usize,
     /// Triangles left below the smallest angle (at small angles between region boundaries).
     pub triangles_below_min_angle: usize,
+    /// Edges of the simplified boundary graph G' (quads).
+    pub simplified_edges: usize,
+    /// Triangles of DT' (quads).
+    pub dt_triangles: usize,
+    /// DT' triangles left unpaired (quads).
+    pub unpaired_triangles: usize,
+    /// G' edges whose curve was flattened to keep every quad valid (quads).
+    pub damped_curves: usize,
     /// Vertices of the output mesh.
     pub vertices: usize,
     /// Elements of the output mesh.
     pub elements: usize,
+    /// Quads of the output mesh.
+    pub quads: usize,
+    /// Triangles of the output mesh.
+    pub triangles: usize,
+}
+
+/// Quality statistics of the output mesh: quads or triangles.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum MeshQuality {
+    /// Verdict's quad metrics.
+    Quads(QuadQuality),
+    /// Verdict's triangle metrics.
+    Triangles(TriangleQuality),
+}
+
+impl MeshQuality {
+    /// Shape statistics.
+    pub fn shape(&self) -> &Statistics {
+        match self {
+            Self::Quads(q) => &q.shape,
+            Self::Triangles(t) => &t.shape,
+        }
+    }
+
+    /// Smallest-angle statistics (degrees).
+    pub fn min_angle_deg(&self) -> &Statistics {
+        match self {
+            Self::Quads(q) => &q.min_angle_deg,
+            Self::Triangles(t) => &t.min_angle_deg,
+        }
+    }
+
+    /// Scaled Jacobian statistics.
+    pub fn scaled_jacobian(&self) -> &Statistics {
+        match self {
+            Self::Quads(q) => &q.scaled_jacobian,
+            Self::Triangles(t) => &t.scaled_jacobian,
+        }
+    }
 }
 
 /// The invariant checks' outcome.
@@ -160,8 +256,8 @@ pub struct Report {
     pub seconds: StageSeconds,
     /// Share of pixels whose centre lies in an element of the pixel's label.
     pub label_agreement: f64,
-    /// Triangle quality statistics.
-    pub quality: TriangleQuality,
+    /// Quality statistics.
+    pub quality: MeshQuality,
     /// Invariant checks.
     pub validation: Validation,
 }
@@ -234,16 +330,25 @@ impl Pipeline {
                 ..Default::default()
             },
         )?;
-        let t_sample = start.elapsed().as_secs_f64();
-        let refined = segmented.refine(&RefineOptions {
-            min_angle_deg: o.min_angle,
-            max_steiner: o.max_steiner.unwrap_or(usize::MAX),
-            max_area: o.max_area,
-        })?;
-        let t_refine = start.elapsed().as_secs_f64() - t_sample;
-        let (vertices, triangles, labels) = segmented.arrays();
-        let elements: Vec<Element> = triangles.iter().map(|&t| Element::Triangle(t)).collect();
+        let mut seconds = StageSeconds {
+            classify: classified,
+            sample: start.elapsed().as_secs_f64(),
+            ..Default::default()
+        };
         let (w, h) = (grid.width(), grid.height());
+        let mut counts = Counts {
+            width: w,
+            height: h,
+            labels: grid.num_labels(),
+            sampled_vertices: segmented.inserted,
+            c_edges: segmented.c_edges.len(),
+            ..Default::default()
+        };
+        let (vertices, elements, labels) = match o.elements {
+            Elements::Tri => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
+            Elements::Quad => self.quads(&segmented, &mut counts, &mut seconds)?,
+        };
+        let check = Instant::now();
         let checked = validate(
             &MeshView {
                 vertices: &vertices,
@@ -255,24 +360,35 @@ impl Pipeline {
         if !checked.is_valid() {
             return Err(PipelineError::Invalid(format!("{:?}", checked.violations)));
         }
-        let quality = TriangleQuality::of(&vertices, &triangles);
-        let label_agreement = segmented.label_agreement(grid);
-        let t_check = start.elapsed().as_secs_f64() - t_sample - t_refine;
-        let counts = Counts {
-            width: w,
-            height: h,
-            labels: grid.num_labels(),
-            sampled_vertices: segmented.inserted,
-            c_edges: segmented.c_edges.len(),
-            refinement_points: refined.inserted,
-            triangles_below_min_angle: if refined.stopped == StopReason::Done {
-                refined.bad_left
-            } else {
-                0
-            },
-            vertices: vertices.len(),
-            elements: elements.len(),
+        let quality = match o.elements {
+            Elements::Tri => {
+                let triangles: Vec<[u32; 3]> = elements
+                    .iter()
+                    .filter_map(|e| match e {
+                        Element::Triangle(t) => Some(*t),
+                        Element::Quad(_) => None,
+                    })
+                    .collect();
+                MeshQuality::Triangles(TriangleQuality::of(&vertices, &triangles))
+            }
+            Elements::Quad => {
+                let quads: Vec<[u32; 4]> = elements
+                    .iter()
+                    .filter_map(|e| match e {
+                        Element::Quad(q) => Some(*q),
+                        Element::Triangle(_) => None,
+                    })
+                    .collect();
+                MeshQuality::Quads(QuadQuality::of(&vertices, &quads))
+            }
         };
+        counts.vertices = vertices.len();
+        counts.elements = elements.len();
+        counts.quads = elements
+            .iter()
+            .filter(|e| matches!(e, Element::Quad(_)))
+            .count();
+        counts.triangles = elements.len() - counts.quads;
         let mesh = SegmentedMeshData {
             vertices,
             elements,
@@ -282,16 +398,13 @@ impl Pipeline {
             width: w,
             height: h,
         };
+        let label_agreement = label_agreement(&mesh, grid);
+        seconds.check = check.elapsed().as_secs_f64();
+        seconds.total = classified + start.elapsed().as_secs_f64();
         let report = Report {
             options: o.clone(),
             counts,
-            seconds: StageSeconds {
-                classify: classified,
-                sample: t_sample,
-                refine: t_refine,
-                check: t_check,
-                total: classified + t_sample + t_refine + t_check,
-            },
+            seconds,
             label_agreement,
             quality,
             validation: Validation {
@@ -302,12 +415,115 @@ impl Pipeline {
         Ok(PipelineResult { mesh, report })
     }
 
+    /// The Imesh triangle output: label-aware Ruppert refinement.
+    fn triangles(
+        &self,
+        segmented: &mut SegmentedMesh,
+        counts: &mut Counts,
+        seconds: &mut StageSeconds,
+    ) -> Result<MeshArrays, PipelineError> {
+        let o = &self.options;
+        let start = Instant::now();
+        let refined = segmented.refine(&RefineOptions {
+            min_angle_deg: o.min_angle.unwrap_or(imesh_segment::DEFAULT_MIN_ANGLE),
+            max_steiner: o.max_steiner.unwrap_or(usize::MAX),
+            max_area: o.max_size.map(equilateral_area),
+        })?;
+        seconds.refine = start.elapsed().as_secs_f64();
+        counts.refinement_points = refined.inserted;
+        counts.triangles_below_min_angle = if refined.stopped == StopReason::Done {
+            refined.bad_left
+        } else {
+            0
+        };
+        let (vertices, triangles, labels) = segmented.arrays();
+        let elements = triangles.iter().map(|&t| Element::Triangle(t)).collect();
+        Ok((vertices, elements, labels))
+    }
+
+    /// The quad output: curves, DT', pairing, templates and boundary adaptation.
+    fn quads(
+        &self,
+        segmented: &SegmentedMesh,
+        counts: &mut Counts,
+        seconds: &mut StageSeconds,
+    ) -> Result<MeshArrays, PipelineError> {
+        let o = &self.options;
+        let start = Instant::now();
+        let edges = segmented
+            .c_edges
+            .iter()
+            .map(|e| GraphEdge {
+                ends: e.vertices.map(|v| v.index() as u32),
+                labels: e.labels,
+            })
+            .collect();
+        let mut g = CurveGraph::new(segmented.triangulation.points().to_vec(), edges)?;
+        g.pin_domain_corners(f64::from(segmented.width), f64::from(segmented.height));
+        let simplified = simplify(
+            &g,
+            &SimplifyOptions {
+                tolerance: o.tolerance,
+            },
+        )?;
+        let fits = fit_edges(&simplified, &g, &FitOptions::default());
+        let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
+        seconds.curves = start.elapsed().as_secs_f64();
+        let r = remesh(
+            &simplified.graph,
+            &curves,
+            &QuadOptions {
+                density: DensityOptions {
+                    min_angle_deg: o
+                        .min_angle
+                        .unwrap_or(DensityOptions::default().min_angle_deg),
+                    max_steiner: o.max_steiner.unwrap_or(usize::MAX),
+                    max_size: o.max_size,
+                },
+                pairing: match o.pairing {
+                    PairingMethod::Greedy => Pairing::Greedy,
+                    PairingMethod::Matching => Pairing::Matching,
+                },
+                level: o.template_level,
+            },
+        )?;
+        seconds.quads = start.elapsed().as_secs_f64() - seconds.curves;
+        counts.simplified_edges = simplified.graph.edges().len();
+        counts.dt_triangles = r.dt.triangulation.num_triangles();
+        counts.refinement_points = r.dt.refinement.inserted;
+        counts.unpaired_triangles = r.elements.unpaired;
+        counts.damped_curves = r.adaptation.damped_curves;
+        if r.adaptation.invalid_left > 0 {
+            return Err(PipelineError::Invalid(format!(
+                "{} quads stayed inverted after boundary adaptation",
+                r.adaptation.invalid_left
+            )));
+        }
+        let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
+        let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
+        Ok((vertices, elements, r.mesh.labels))
+    }
+
     fn check_options(&self) -> Result<(), PipelineError> {
         let o = &self.options;
-        if o.elements == Elements::Quad {
-            return Err(PipelineError::Options(
-                "quad meshes are not in this build yet: use --elements tri (the default)".into(),
-            ));
+        if !(1..=8).contains(&o.template_level) {
+            return Err(PipelineError::Options(format!(
+                "template level {} is out of range: give 1 to 8",
+                o.template_level
+            )));
+        }
+        if !(o.tolerance.is_finite() && o.tolerance >= 0.0) {
+            return Err(PipelineError::Options(format!(
+                "the curve tolerance must be a distance in pixels ≥ 0, not {}",
+                o.tolerance
+            )));
+        }
+        if let Some(s) = o.max_size {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(PipelineError::Options(format!(
+                    "the largest element size must be a positive number of pixels, not {s}"
+                )));
+            }
         }
         if !(o.pixel_size[0] > 0.0
             && o.pixel_size[1] > 0.0
@@ -320,4 +536,59 @@ impl Pipeline {
         }
         Ok(())
     }
+}
+
+/// Vertices, elements and labels of a mesh.
+type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
+
+/// The area of the equilateral triangle of side `s`.
+fn equilateral_area(s: f64) -> f64 {
+    3f64.sqrt() / 4.0 * s * s
+}
+
+/// The share of pixels whose centre lies in an element of the pixel's own label (on an edge
+/// between two elements, either counts). Elements are convex (positive Jacobian at every corner),
+/// so a centre is inside when it is on the inner side of every edge.
+pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    if w == 0 || h == 0 {
+        return 1.0;
+    }
+    let mut agrees = vec![false; w * h];
+    for (element, &label) in mesh.elements.iter().zip(&mesh.labels) {
+        let corners: Vec<[f64; 2]> = element
+            .corners()
+            .iter()
+            .map(|&v| mesh.vertices[v as usize])
+            .collect();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for c in &corners {
+            for k in 0..2 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        // Pixel centres (col + 0.5, row + 0.5) inside the bounding box.
+        let first = |x: f64| (x - 0.5).ceil().max(0.0) as usize;
+        let last = |x: f64, n: usize| ((x - 0.5).floor().min(n as f64 - 1.0)).max(-1.0);
+        let (c0, r0) = (first(lo[0]), first(lo[1]));
+        let (c1, r1) = (last(hi[0], w), last(hi[1], h));
+        if c1 < 0.0 || r1 < 0.0 {
+            continue;
+        }
+        for row in r0..=r1 as usize {
+            for col in c0..=c1 as usize {
+                let p = [col as f64 + 0.5, row as f64 + 0.5];
+                let n = corners.len();
+                let inside = (0..n).all(|i| {
+                    let (a, b) = (corners[i], corners[(i + 1) % n]);
+                    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0.0
+                });
+                if inside && grid.label(col as u32, row as u32) == label {
+                    agrees[row * w + col] = true;
+                }
+            }
+        }
+    }
+    agrees.iter().filter(|&&a| a).count() as f64 / (w * h) as f64
 }

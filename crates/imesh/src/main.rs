@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use imesh::{Elements, MeshOptions, Pipeline, PipelineResult};
+use imesh::{Elements, MeshOptions, PairingMethod, Pipeline, PipelineResult};
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
@@ -92,16 +92,28 @@ struct MeshFlags {
     /// Imesh error threshold (smaller: more vertices, closer boundaries) [default: 0.1].
     #[arg(long)]
     te: Option<f64>,
-    /// Smallest triangle angle in degrees, at most 34 [default: 26.4].
+    /// Smallest triangle angle in degrees, at most 34: of the triangles paired into quads
+    /// [default: 20.7], or of the triangle mesh [default: 26.4].
     #[arg(long)]
     min_angle: Option<f64>,
     /// Most points the quality refinement may insert.
     #[arg(long)]
     max_steiner: Option<usize>,
-    /// Largest element edge in pixels: no triangle gets larger than the equilateral one of this side.
+    /// Largest element size in pixels: no triangle (before pairing) gets larger than the
+    /// equilateral one of this side.
     #[arg(long)]
     max_size: Option<f64>,
-    /// Element kind: tri (today's output) or quad (coming).
+    /// Curve simplification tolerance in pixels [default: 2].
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Template level k: each triangle gives 3k² quads, each paired quad 4k² [default: 1].
+    #[arg(long)]
+    template_level: Option<u32>,
+    /// Pairing of triangles into quads: matching (fewer triangles left) or greedy (the paper's)
+    /// [default: matching].
+    #[arg(long)]
+    pairing: Option<PairingMethod>,
+    /// Element kind: quad (all-quad mesh) or tri (the Imesh triangle mesh) [default: quad].
     #[arg(long)]
     elements: Option<Elements>,
     /// Physical size of a pixel: SX or SX,SY.
@@ -170,14 +182,22 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
         o.te = te;
     }
     if let Some(a) = args.min_angle {
-        o.min_angle = a;
+        o.min_angle = Some(a);
+    }
+    if let Some(t) = args.tolerance {
+        o.tolerance = t;
+    }
+    if let Some(k) = args.template_level {
+        o.template_level = k;
+    }
+    if let Some(p) = args.pairing {
+        o.pairing = p;
     }
     if let Some(n) = args.max_steiner {
         o.max_steiner = Some(n);
     }
     if let Some(s) = args.max_size {
-        // An equilateral triangle of side s.
-        o.max_area = Some(s * s * 3f64.sqrt() / 4.0);
+        o.max_size = Some(s);
     }
     if let Some(e) = args.elements {
         o.elements = e;
@@ -211,7 +231,7 @@ fn format_of(output: &Path) -> Result<String, String> {
     }
 }
 
-/// Writes the mesh in the format its name says, with the triangles' shape as cell data where the
+/// Writes the mesh in the format its name says, with the elements' shape as cell data where the
 /// format holds it.
 fn write_mesh(
     output: &Path,
@@ -225,8 +245,11 @@ fn write_mesh(
             .elements
             .iter()
             .map(|e| {
-                let c = e.corners();
-                imesh_quality::tri::shape(&[c[0], c[1], c[2]].map(|v| mesh.vertices[v as usize]))
+                let p = |v: u32| mesh.vertices[v as usize];
+                match *e {
+                    imesh_quality::Element::Triangle(t) => imesh_quality::tri::shape(&t.map(p)),
+                    imesh_quality::Element::Quad(q) => imesh_quality::quad::shape(&q.map(p)),
+                }
             })
             .collect();
         vec![("shape".to_string(), shape)]
@@ -277,24 +300,32 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         let c = &report.counts;
         let q = &report.quality;
         println!(
-            "{}: {}×{} px, {} labels → {} ({} vertices, {} triangles) in {:.3} s",
+            "{}: {}×{} px, {} labels → {} ({} vertices, {} quads, {} triangles) in {:.3} s",
             args.image.display(),
             c.width,
             c.height,
             c.labels,
             output.display(),
             c.vertices,
-            c.elements,
+            c.quads,
+            c.triangles,
             report.seconds.total
         );
-        println!(
-            "label agreement {:.2} %; smallest angle worst {:.1}°, mean {:.1}°; shape worst {:.3}, mean {:.3}",
+        let mut line = format!(
+            "label agreement {:.2} %; smallest angle worst {:.1}°, mean {:.1}°; scaled Jacobian worst {:.3}, mean {:.3}",
             100.0 * report.label_agreement,
-            q.min_angle_deg.min,
-            q.min_angle_deg.mean,
-            q.shape.min,
-            q.shape.mean
+            q.min_angle_deg().min,
+            q.min_angle_deg().mean,
+            q.scaled_jacobian().min,
+            q.scaled_jacobian().mean,
         );
+        if let imesh::MeshQuality::Quads(quads) = q {
+            line += &format!(
+                "; shape-and-size worst {:.3}, mean {:.3}",
+                quads.shape_and_size.min, quads.shape_and_size.mean
+            );
+        }
+        println!("{line}");
     }
     Ok(())
 }

@@ -95,6 +95,19 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
     assert!(report["label_agreement"].as_f64().unwrap() > 0.97);
+    // The default is an all-quad mesh, and the report says how it was made.
+    assert_eq!(report["counts"]["triangles"], 0);
+    assert_eq!(report["counts"]["quads"], report["counts"]["elements"]);
+    assert!(report["counts"]["simplified_edges"].as_u64().unwrap() > 0);
+    assert!(report["quality"]["shape_and_size"]["min"].as_f64().unwrap() > 0.0);
+    assert!(
+        report["quality"]["scaled_jacobian"]["min"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    assert_eq!(report["options"]["elements"], "quad");
+    assert_eq!(report["options"]["tolerance"], 2.0);
     let png = std::fs::read(dir.path().join("m.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "a PNG picture");
     assert!(std::fs::read_to_string(dir.path().join("m.svg"))
@@ -149,13 +162,52 @@ fn abaqus_and_legacy_vtk_outputs() {
     }
     let inp = std::fs::read_to_string(dir.path().join("m.inp")).unwrap();
     assert_eq!(
-        inp.matches("*Element, type=CPS3").count(),
+        inp.matches("*Element, type=CPS4").count(),
         5,
-        "an element set per label"
+        "an element set of quads per label"
     );
+    assert!(!inp.contains("CPS3"), "the default mesh is all quads");
     assert!(inp.contains("*Nset, nset=border_"));
     let vtk = std::fs::read_to_string(dir.path().join("m.vtk")).unwrap();
     assert!(vtk.contains("SCALARS label int 1") && vtk.contains("SCALARS shape double 1"));
+}
+
+#[test]
+fn the_triangle_mesh_and_quad_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("stardist-mask2d_labels.png");
+    let image = image.to_str().unwrap();
+    let run = |extra: &[&str], report: &str| {
+        let mut args = vec!["mesh", image, "-o", "m.inp", "-q", "--report", report];
+        args.extend_from_slice(extra);
+        let out = imesh(&args, dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(dir.path().join(report)).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let tri = run(&["--elements", "tri"], "tri.json");
+    assert_eq!(tri["counts"]["quads"], 0);
+    assert!(tri["quality"]["min_angle_deg"]["mean"].as_f64().unwrap() > 30.0);
+    let inp = std::fs::read_to_string(dir.path().join("m.inp")).unwrap();
+    assert!(inp.contains("CPS3") && !inp.contains("CPS4"));
+    let level1 = run(&["--pairing", "greedy"], "g1.json");
+    let level2 = run(&["--pairing", "greedy", "--template-level", "2"], "g2.json");
+    let quads = |r: &serde_json::Value| r["counts"]["quads"].as_u64().unwrap();
+    assert_eq!(
+        quads(&level2),
+        4 * quads(&level1),
+        "level 2 splits every quad in four"
+    );
+    let matching = run(&["--pairing", "matching"], "m.json");
+    let unpaired = |r: &serde_json::Value| r["counts"]["unpaired_triangles"].as_u64().unwrap();
+    assert!(unpaired(&matching) < unpaired(&level1));
+    let coarse = run(&["--tolerance", "5"], "t5.json");
+    let edges = |r: &serde_json::Value| r["counts"]["simplified_edges"].as_u64().unwrap();
+    assert!(edges(&coarse) < edges(&matching));
 }
 
 #[test]
@@ -163,12 +215,15 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
     let image = image.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["mesh", "missing.png"], "missing.png"),
         (&["mesh", image, "-o", "out.obj"], ".msh"),
         (&["mesh", image, "--te", "2"], "t_e"),
         (&["mesh", image, "--min-angle", "40"], "34"),
-        (&["mesh", image, "--elements", "quad"], "quad"),
+        (&["mesh", image, "--elements", "hex"], "quad"),
+        (&["mesh", image, "--template-level", "9"], "1 to 8"),
+        (&["mesh", image, "--tolerance=-1"], "tolerance"),
+        (&["mesh", image, "--pairing", "best"], "greedy or matching"),
     ];
     for (args, hint) in cases {
         let out = imesh(args, dir.path());
