@@ -4,6 +4,8 @@
 use imesh_geom::Point;
 use nalgebra::DMatrix;
 
+use crate::distance::{segment_distance, segment_parameter};
+
 /// A cubic Bézier curve `b(t) = Σ Bᵢ³(t) pᵢ`, `t ∈ [0, 1]`.
 ///
 /// ```
@@ -392,29 +394,13 @@ fn measure_segment(a: Point, b: Point, points: &[Point]) -> CurveFit {
         sum += d2;
     }
     let curve = CubicBezier::segment(a, b);
-    let t: Vec<f64> = points.iter().map(|&p| projection(a, b, p)).collect();
+    let t: Vec<f64> = points.iter().map(|&p| segment_parameter(a, b, p)).collect();
     CurveFit {
         curve,
         max_error: max,
         rms_error: (sum / points.len() as f64).sqrt(),
         curve_deviation: curve_deviation(&curve, points, &t),
     }
-}
-
-/// The parameter of the projection of `p` on the segment `ab`.
-fn projection(a: Point, b: Point, p: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.x * ab.x + ab.y * ab.y;
-    if len2 > 0.0 {
-        (((p.x - a.x) * ab.x + (p.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    }
-}
-
-/// Distance from `q` to the closed segment `ab`.
-fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
-    q.distance_squared(a + (b - a) * projection(a, b, q)).sqrt()
 }
 
 /// How far the curve strays from the chain `points` (whose projections on the curve are at `t`):

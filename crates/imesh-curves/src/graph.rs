@@ -109,6 +109,22 @@ impl CurveGraph {
         })
     }
 
+    /// The boundary graph of a segmented image of `width` × `height` pixels: [`CurveGraph::new`],
+    /// then [`CurveGraph::pin_domain_corners`].
+    ///
+    /// # Errors
+    /// As [`CurveGraph::new`].
+    pub fn image_boundaries(
+        points: Vec<Point>,
+        edges: Vec<GraphEdge>,
+        width: f64,
+        height: f64,
+    ) -> Result<Self, CurveError> {
+        let mut g = Self::new(points, edges)?;
+        g.pin_domain_corners(width, height);
+        Ok(g)
+    }
+
     /// The points (vertex positions).
     pub fn points(&self) -> &[Point] {
         &self.points

@@ -30,6 +30,7 @@
 //! ```
 
 mod bezier;
+mod distance;
 mod faces;
 mod graph;
 mod grid;
@@ -39,6 +40,7 @@ mod simplify;
 use rayon::prelude::*;
 
 pub use bezier::{fit_cubic, fit_cubic_at, CubicBezier, CurveFit, FitOptions};
+pub use distance::{segment_distance, segment_distance_squared, segment_parameter};
 pub use graph::{CurveGraph, Face, GraphEdge};
 pub use polyline::{polylines, Polyline};
 pub use simplify::{simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE};

@@ -19,6 +19,7 @@
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 
+use crate::distance::{segment_distance, segment_distance_squared};
 use crate::graph::{CurveGraph, GraphEdge};
 use crate::grid::{conflict, edge_cells, grid_for, within, CellLists, Grid};
 use crate::polyline::{polylines, Polyline};
@@ -122,23 +123,6 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
         refused: state.refused,
         max_deviation,
     })
-}
-
-/// Distance from `q` to the closed segment `ab`.
-pub(crate) fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
-    segment_distance_squared(a, b, q).sqrt()
-}
-
-/// Squared distance from `q` to the closed segment `ab`.
-fn segment_distance_squared(a: Point, b: Point, q: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.x * ab.x + ab.y * ab.y;
-    let t = if len2 > 0.0 {
-        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    q.distance_squared(a + ab * t)
 }
 
 /// The current graph during simplification: every edge (original, or a chord that replaced a

@@ -3,8 +3,8 @@
 mod support;
 
 use imesh_curves::{
-    fit_edges, polylines, simplify, CurveError, CurveGraph, FitOptions, GraphEdge, Simplification,
-    SimplifyOptions,
+    fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph, FitOptions,
+    GraphEdge, Simplification, SimplifyOptions,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -60,7 +60,7 @@ fn check_simplification(g: &CurveGraph, s: &Simplification, tolerance: f64) {
         assert_eq!([chain[0], chain[chain.len() - 1]], [a, b]);
         let (pa, pb) = (g.point(a), g.point(b));
         for &v in chain {
-            let d = distance_to_segment(pa, pb, g.point(v));
+            let d = segment_distance(pa, pb, g.point(v));
             assert!(
                 d <= tolerance * (1.0 + 1e-12) + 1e-12,
                 "vertex {v} is {d} px from its edge"
@@ -80,17 +80,6 @@ fn check_simplification(g: &CurveGraph, s: &Simplification, tolerance: f64) {
         assert!(f.consistent, "a face of G' has two labels");
         assert!(f.area != 0.0, "a face of G' has no area");
     }
-}
-
-fn distance_to_segment(a: Point, b: Point, q: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.x * ab.x + ab.y * ab.y;
-    let t = if len2 > 0.0 {
-        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    q.distance_squared(a + ab * t).sqrt()
 }
 
 /// A random planar label image: nearest-seed regions plus isolated noise pixels.
@@ -384,7 +373,7 @@ fn rms_to_edges(g: &CurveGraph, s: &Simplification) -> f64 {
     for chain in &s.chains {
         let (a, b) = (g.point(chain[0]), g.point(chain[chain.len() - 1]));
         for &v in chain {
-            let d = distance_to_segment(a, b, g.point(v));
+            let d = segment_distance(a, b, g.point(v));
             sum += d * d;
             count += 1;
         }

@@ -31,8 +31,9 @@ fn bench(c: &mut Criterion) {
             labels: e.labels,
         })
         .collect();
-    let mut g = CurveGraph::new(m.triangulation.points().to_vec(), edges).expect("valid c-edges");
-    g.pin_domain_corners(f64::from(grid.width()), f64::from(grid.height()));
+    let (w, h) = (f64::from(grid.width()), f64::from(grid.height()));
+    let g = CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, w, h)
+        .expect("valid c-edges");
     let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
     let curves: Vec<_> = fit_edges(&s, &g, &FitOptions::default())
         .fits

@@ -2,7 +2,7 @@
 
 use imesh_curves::CurveGraph;
 use imesh_geom::{
-    HalfEdgeId, Point, RefineOptions, RefineReport, SegmentId, TriangleId, Triangulation, VertexId,
+    HalfEdgeId, RefineOptions, RefineReport, SegmentId, TriangleId, Triangulation, VertexId,
 };
 
 use crate::QuadError;
@@ -138,7 +138,7 @@ impl RegionTriangulation {
     /// The parameter in `[0, 1]` of vertex `v` along the straight G' edge `k` (from `ends[0]`).
     pub fn edge_parameter(&self, g: &CurveGraph, k: u32, v: VertexId) -> f64 {
         let [a, b] = g.edges()[k as usize].ends.map(|x| g.point(x));
-        parameter_on(a, b, self.triangulation.point(v))
+        imesh_curves::segment_parameter(a, b, self.triangulation.point(v))
     }
 
     /// The pieces of segment `s` in order, as vertices.
@@ -206,14 +206,4 @@ fn graph_edge(
     let a = g.point(g.edges()[k as usize].ends[0]);
     let (u, w) = (t.point(t.origin(h)), t.point(t.destination(h)));
     Some((k, a.distance_squared(u) < a.distance_squared(w)))
-}
-
-/// The parameter of the projection of `p` on the line `ab`, clamped to `[0, 1]`.
-pub(crate) fn parameter_on(a: Point, b: Point, p: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.x * ab.x + ab.y * ab.y;
-    if len2 == 0.0 {
-        return 0.0;
-    }
-    (((p.x - a.x) * ab.x + (p.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
 }

@@ -4,7 +4,9 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
-use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
+use imesh_curves::{
+    fit_edges, segment_distance, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions,
+};
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
@@ -44,9 +46,10 @@ fn curves(grid: &LabelGrid) -> Curves {
             labels: e.labels,
         })
         .collect();
-    let mut original = CurveGraph::new(m.triangulation.points().to_vec(), edges).unwrap();
     let (width, height) = (f64::from(grid.width()), f64::from(grid.height()));
-    original.pin_domain_corners(width, height);
+    let original =
+        CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, width, height)
+            .unwrap();
     let simplified = simplify(
         &original,
         &SimplifyOptions {
@@ -237,17 +240,6 @@ fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
         assert!(checked > 0);
         let _ = g;
     }
-}
-
-fn segment_distance(a: Point, b: Point, q: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.x * ab.x + ab.y * ab.y;
-    let t = if len2 > 0.0 {
-        (((q.x - a.x) * ab.x + (q.y - a.y) * ab.y) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    q.distance_squared(a + ab * t).sqrt()
 }
 
 #[test]

@@ -458,8 +458,12 @@ impl Pipeline {
                 labels: e.labels,
             })
             .collect();
-        let mut g = CurveGraph::new(segmented.triangulation.points().to_vec(), edges)?;
-        g.pin_domain_corners(f64::from(segmented.width), f64::from(segmented.height));
+        let g = CurveGraph::image_boundaries(
+            segmented.triangulation.points().to_vec(),
+            edges,
+            f64::from(segmented.width),
+            f64::from(segmented.height),
+        )?;
         let simplified = simplify(
             &g,
             &SimplifyOptions {

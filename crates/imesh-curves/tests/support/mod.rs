@@ -67,9 +67,8 @@ pub fn pixel_boundaries(grid: &LabelGrid) -> CurveGraph {
             }
         }
     }
-    let mut g = CurveGraph::new(points, edges).expect("a valid pixel-boundary graph");
-    g.pin_domain_corners(w as f64, h as f64);
-    g
+    CurveGraph::image_boundaries(points, edges, w as f64, h as f64)
+        .expect("a valid pixel-boundary graph")
 }
 
 /// The Imesh c-edge graph of `grid` (sampling and partition, DESIGN.md §2 steps 2–3).
@@ -83,7 +82,7 @@ pub fn imesh_boundaries(grid: &LabelGrid) -> CurveGraph {
             labels: e.labels,
         })
         .collect();
-    let mut g = CurveGraph::new(m.triangulation.points().to_vec(), edges).expect("valid c-edges");
-    g.pin_domain_corners(f64::from(grid.width()), f64::from(grid.height()));
-    g
+    let (w, h) = (f64::from(grid.width()), f64::from(grid.height()));
+    CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, w, h)
+        .expect("valid c-edges")
 }
