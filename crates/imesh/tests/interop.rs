@@ -56,10 +56,13 @@ fn meshio_reads_our_msh_and_vtu() {
                 .unwrap();
         let read = meshio_read(&python, &dir.path().join(name));
         assert_eq!(read["points"], report["counts"]["vertices"], "{name}");
+        // The default mesh is all quads.
+        assert_eq!(read["cells"]["quad"], report["counts"]["quads"], "{name}");
         assert_eq!(
-            read["cells"]["triangle"], report["counts"]["elements"],
+            read["cells"]["quad"], report["counts"]["elements"],
             "{name}"
         );
+        assert!(read["cells"]["triangle"].is_null(), "{name}: no triangles");
         assert_eq!(
             read["negative"], 0,
             "{name}: clockwise elements in the written frame"
