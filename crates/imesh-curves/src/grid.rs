@@ -79,6 +79,15 @@ impl Grid {
         let dx = right.x - left.x;
         let c0 = self.column(left.x - pad);
         let c1 = self.column(right.x + pad);
+        let margin = pad + 1e-9 * self.h;
+        if c0 == c1 {
+            // One column (most short edges): every row the segment's y-range meets.
+            let (y0, y1) = (left.y.min(right.y), left.y.max(right.y));
+            for cy in self.row(y0 - margin)..=self.row(y1 + margin) {
+                f(cy * self.nx + c0);
+            }
+            return;
+        }
         for cx in c0..=c1 {
             let slab0 = self.origin.x + cx as f64 * self.h - pad;
             let slab1 = slab0 + self.h + 2.0 * pad;
@@ -93,8 +102,8 @@ impl Grid {
                 );
                 (ya.min(yb), ya.max(yb))
             };
-            // The parameter arithmetic rounds: widen by a rounding margin on top of `pad`.
-            let margin = pad + 1e-9 * self.h;
+            // The parameter arithmetic rounds: the margin widens by a rounding error on top of
+            // `pad`.
             for cy in self.row(y0 - margin)..=self.row(y1 + margin) {
                 f(cy * self.nx + cx);
             }
@@ -147,53 +156,74 @@ pub(crate) fn within(a: Point, b: Point, q: Point) -> bool {
     q.x >= a.x.min(b.x) && q.x <= a.x.max(b.x) && q.y >= a.y.min(b.y) && q.y <= a.y.max(b.y)
 }
 
-/// Items per cell as singly linked lists in flat arrays: appending never allocates per cell,
-/// which matters with 10^5 cells and items added during simplification.
+/// Items per cell: those known at the start stored contiguously per cell (compressed rows, so a
+/// query reads one slice), and those added later as singly linked lists in flat arrays (appending
+/// never allocates per cell).
 #[derive(Clone, Debug)]
 pub(crate) struct CellLists {
+    first: Vec<u32>,
+    items: Vec<u32>,
     head: Vec<u32>,
     next: Vec<u32>,
-    item: Vec<u32>,
+    added: Vec<u32>,
 }
 
 const END: u32 = u32::MAX;
 
 impl CellLists {
-    pub(crate) fn new(cells: usize, capacity: usize) -> Self {
+    /// The lists of `cells` cells holding `(cell, item)` pairs.
+    pub(crate) fn new(cells: usize, pairs: &[(u32, u32)]) -> Self {
+        // A counting sort by cell.
+        let mut first = vec![0u32; cells + 1];
+        for &(c, _) in pairs {
+            first[c as usize + 1] += 1;
+        }
+        for c in 0..cells {
+            first[c + 1] += first[c];
+        }
+        let mut fill = first.clone();
+        let mut items = vec![0u32; pairs.len()];
+        for &(c, item) in pairs {
+            items[fill[c as usize] as usize] = item;
+            fill[c as usize] += 1;
+        }
         Self {
+            first,
+            items,
             head: vec![END; cells],
-            next: Vec::with_capacity(capacity),
-            item: Vec::with_capacity(capacity),
+            next: Vec::new(),
+            added: Vec::new(),
         }
     }
 
     pub(crate) fn push(&mut self, cell: usize, item: u32) {
         self.next.push(self.head[cell]);
-        self.item.push(item);
-        self.head[cell] = (self.item.len() - 1) as u32;
+        self.added.push(item);
+        self.head[cell] = (self.added.len() - 1) as u32;
     }
 
     pub(crate) fn iter(&self, cell: usize) -> impl Iterator<Item = u32> + '_ {
+        let fixed = &self.items[self.first[cell] as usize..self.first[cell + 1] as usize];
         let mut at = self.head[cell];
-        std::iter::from_fn(move || {
+        fixed.iter().copied().chain(std::iter::from_fn(move || {
             (at != END).then(|| {
-                let x = self.item[at as usize];
+                let x = self.added[at as usize];
                 at = self.next[at as usize];
                 x
             })
-        })
+        }))
     }
 }
 
 /// Registers each edge of `g` in the cells it meets.
 pub(crate) fn edge_cells(g: &CurveGraph, grid: &Grid) -> CellLists {
-    let mut cells = CellLists::new(grid.len(), 2 * g.edges().len());
+    let mut pairs = Vec::with_capacity(2 * g.edges().len());
     for (i, e) in g.edges().iter().enumerate() {
         grid.cells_near_segment(g.point(e.ends[0]), g.point(e.ends[1]), 0.0, |c| {
-            cells.push(c, i as u32);
+            pairs.push((c as u32, i as u32));
         });
     }
-    cells
+    CellLists::new(grid.len(), &pairs)
 }
 
 /// A grid with about one cell per four edges (cells a few edge lengths wide).
