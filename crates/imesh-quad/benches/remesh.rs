@@ -8,12 +8,15 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use imesh_classify::{luminance, threshold};
-use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
+use imesh_classify::{luminance, multi_otsu_levels, threshold};
+use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
 use imesh_quad::{
     adapt, ControlNet, DensityOptions, ElementMesh, Pairing, QuadMesh, RegionTriangulation,
 };
-use imesh_segment::{SampleOptions, SegmentedMesh};
+
+// The c-edge graph of a label grid, as imesh-curves' tests build it.
+#[path = "../../imesh-curves/tests/support/mod.rs"]
+mod support;
 
 fn bench(c: &mut Criterion) {
     let path =
@@ -21,19 +24,8 @@ fn bench(c: &mut Criterion) {
     let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS)
         .expect("the fixture skimage-grass.png loads");
     let grey = luminance(&image);
-    let grid = threshold(&grey, &[imageproc_otsu(&grey)]);
-    let m = SegmentedMesh::from_grid(&grid, &SampleOptions::default()).expect("sampling works");
-    let edges = m
-        .c_edges
-        .iter()
-        .map(|e| GraphEdge {
-            ends: e.vertices.map(|v| v.index() as u32),
-            labels: e.labels,
-        })
-        .collect();
-    let (w, h) = (f64::from(grid.width()), f64::from(grid.height()));
-    let g = CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, w, h)
-        .expect("valid c-edges");
+    let grid = threshold(&grey, &multi_otsu_levels(&grey, 2));
+    let g = support::imesh_boundaries(&grid);
     let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
     let curves: Vec<_> = fit_edges(&s, &g, &FitOptions::default())
         .fits
@@ -86,11 +78,6 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.finish();
-}
-
-/// Otsu's threshold through the classify crate's multi-level Otsu with two classes.
-fn imageproc_otsu(grey: &image::GrayImage) -> u8 {
-    imesh_classify::multi_otsu_levels(grey, 2)[0]
 }
 
 criterion_group!(benches, bench);

@@ -288,8 +288,3 @@ fn blend(ec: &EdgeCurve) -> [Point; 4] {
     let straight = CubicBezier::segment(chord[0], chord[1]).control;
     [0, 1, 2, 3].map(|i| straight[i] + (c[i] - straight[i]) * w)
 }
-
-/// The point at parameter `s` of an adapted edge as the mesh has it.
-pub fn edge_point(edge: &EdgeCurve, s: f64) -> Point {
-    CubicBezier::new(blend(edge)).eval(s)
-}

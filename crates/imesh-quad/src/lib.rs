@@ -45,7 +45,7 @@ mod pairing;
 mod patch;
 mod template;
 
-pub use adapt::{adapt, edge_point, AdaptReport, EdgeCurve};
+pub use adapt::{adapt, AdaptReport, EdgeCurve};
 pub use dt::{DensityOptions, RegionTriangulation, NONE};
 pub use mesh::{Holder, QuadMesh};
 pub use pairing::{Element, ElementMesh, Pairing};

@@ -161,33 +161,7 @@ impl ControlNet {
 
     /// The point of element `k`'s patch at canonical coordinates `uv`.
     pub fn eval(&self, element: &Element, k: usize, uv: [f64; 2]) -> Point {
-        let slots = &self.patches[k];
-        let p = |slot: usize| self.points[slots[slot] as usize];
-        match element {
-            Element::Triangle(_) => {
-                let (l1, l2) = (uv[0], uv[1]);
-                let l0 = 1.0 - l1 - l2;
-                let powers = |x: f64| [1.0, x, x * x, x * x * x];
-                let (p0, p1, p2) = (powers(l0), powers(l1), powers(l2));
-                let mut sum = Point::new(0.0, 0.0);
-                for (slot, &(a, b)) in TRIANGLE_SLOTS.iter().enumerate() {
-                    let (a, b) = (a as usize, b as usize);
-                    let w = TRIANGLE_COEFFICIENTS[slot] * p0[3 - a - b] * p1[a] * p2[b];
-                    sum = sum + p(slot) * w;
-                }
-                sum
-            }
-            Element::Quad(_) => {
-                let (bs, bt) = (bernstein3(uv[0]), bernstein3(uv[1]));
-                let mut sum = Point::new(0.0, 0.0);
-                for (j, wj) in bt.iter().enumerate() {
-                    for (i, wi) in bs.iter().enumerate() {
-                        sum = sum + p(i + 4 * j) * (wi * wj);
-                    }
-                }
-                sum
-            }
-        }
+        self.eval_weights(k, &basis(matches!(element, Element::Quad(_)), uv))
     }
 
     /// Resets element `k`'s inner control points from its boundary: the discrete Coons patch for

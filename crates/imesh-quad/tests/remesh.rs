@@ -5,13 +5,17 @@ use std::path::Path;
 
 use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
 use imesh_curves::{
-    fit_edges, segment_distance, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions,
+    fit_edges, segment_distance, simplify, CurveGraph, FitOptions, SimplifyOptions,
 };
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
 };
-use imesh_segment::{SampleOptions, SegmentedMesh};
+
+// The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
+// Imesh c-edges to a `CurveGraph` for every test and benchmark.
+#[path = "../../imesh-curves/tests/support/mod.rs"]
+mod support;
 
 const TOLERANCE: f64 = 2.0;
 
@@ -37,19 +41,8 @@ struct Curves {
 }
 
 fn curves(grid: &LabelGrid) -> Curves {
-    let m = SegmentedMesh::from_grid(grid, &SampleOptions::default()).unwrap();
-    let edges = m
-        .c_edges
-        .iter()
-        .map(|e| GraphEdge {
-            ends: e.vertices.map(|v| v.index() as u32),
-            labels: e.labels,
-        })
-        .collect();
+    let original = support::imesh_boundaries(grid);
     let (width, height) = (f64::from(grid.width()), f64::from(grid.height()));
-    let original =
-        CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, width, height)
-            .unwrap();
     let simplified = simplify(
         &original,
         &SimplifyOptions {
