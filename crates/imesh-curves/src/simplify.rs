@@ -19,7 +19,7 @@
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 
-use crate::distance::{segment_distance, segment_distance_squared};
+use crate::distance::segment_distance_squared;
 use crate::graph::{CurveGraph, GraphEdge};
 use crate::grid::{conflict, edge_cells, grid_for, within, CellLists, Grid};
 use crate::polyline::{polylines, Polyline};
@@ -91,16 +91,11 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
     let mut edges = Vec::new();
     let mut chains = Vec::new();
     let mut polyline_of = Vec::new();
-    let mut max_deviation: f64 = 0.0;
     for (index, line) in lines.iter().enumerate() {
         let kept = state.simplify_line(line, tolerance);
         for w in kept.windows(2) {
             let (i, j) = (w[0], w[1]);
             let chain = line.vertices[i..=j].to_vec();
-            let (a, b) = (g.point(chain[0]), g.point(chain[chain.len() - 1]));
-            for &v in &chain[1..chain.len() - 1] {
-                max_deviation = max_deviation.max(segment_distance(a, b, g.point(v)));
-            }
             edges.push(GraphEdge {
                 ends: [chain[0], chain[chain.len() - 1]],
                 labels: line.labels,
@@ -121,7 +116,7 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
         chains,
         polyline_of,
         refused: state.refused,
-        max_deviation,
+        max_deviation: state.max_deviation,
     })
 }
 
@@ -144,6 +139,8 @@ struct State<'g> {
     vertex_in_chain: Vec<u32>,
     query: u32,
     refused: usize,
+    /// The largest distance from a removed vertex to its chord.
+    max_deviation: f64,
 }
 
 impl<'g> State<'g> {
@@ -172,6 +169,7 @@ impl<'g> State<'g> {
             vertex_in_chain: vec![0; n],
             query: 0,
             refused: 0,
+            max_deviation: 0.0,
         }
     }
 
@@ -199,6 +197,7 @@ impl<'g> State<'g> {
                 if straight(self.g.points(), &v[i..=j]) || self.chord_is_safe(line, i, j, deviation)
                 {
                     self.replace(line, i, j);
+                    self.max_deviation = self.max_deviation.max(deviation);
                     continue;
                 }
                 self.refused += 1;
