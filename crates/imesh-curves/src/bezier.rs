@@ -217,7 +217,6 @@ pub fn fit_cubic(points: &[Point], options: &FitOptions) -> CurveFit {
         if best.rms_error <= 1e-14 * scale(points) {
             break;
         }
-        let previous = best.rms_error;
         let Some(step) = normal_step(best.curve, points, &t) else {
             break;
         };
@@ -245,7 +244,7 @@ pub fn fit_cubic(points: &[Point], options: &FitOptions) -> CurveFit {
             }
             damping *= 8.0;
         }
-        if !improved || best.rms_error > 0.999 * previous {
+        if !improved {
             break;
         }
     }
