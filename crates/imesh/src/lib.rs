@@ -3,8 +3,8 @@
 //! [`Pipeline`] composes the stages and times each one; the `imesh` program is a thin command
 //! line over it. Quads (the default): classify → Imesh sampling and partition → curves
 //! (topology-preserving simplification, Bézier fitting) → DT' → pairing → templates → boundary
-//! adaptation → checks. Triangles (`elements = "tri"`): classify → Imesh sampling and partition →
-//! label-aware Ruppert refinement → checks. (Optimisation of the quads joins as it lands.)
+//! adaptation → optimisation → checks. Triangles (`elements = "tri"`): classify → Imesh sampling and
+//! partition → label-aware Ruppert refinement → checks.
 //!
 //! ```
 //! use imesh::{MeshOptions, Pipeline};
@@ -25,6 +25,7 @@ use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGri
 use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
 use imesh_geom::{RefineOptions, StopReason};
 use imesh_io::SegmentedMeshData;
+use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 use imesh_quality::{
     validate, Domain, Element, MeshView, QuadQuality, Statistics, TriangleQuality,
@@ -59,6 +60,71 @@ impl FromStr for PairingMethod {
             "greedy" => Ok(Self::Greedy),
             "matching" => Ok(Self::Matching),
             _ => Err(format!("unknown pairing {s:?}: use greedy or matching")),
+        }
+    }
+}
+
+/// How the quads are optimised (`--optimizer`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OptimizerMethod {
+    /// Block coordinate descent over the free control points (default).
+    Local,
+    /// One Powell run over all free control points (the paper's; slow).
+    Global,
+    /// Laplacian smoothing of the quad vertices (baseline).
+    Laplacian,
+    /// Local optimisation of the quad vertices (baseline).
+    Vertex,
+    /// No optimisation.
+    None,
+}
+
+impl FromStr for OptimizerMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "local" => Ok(Self::Local),
+            "global" => Ok(Self::Global),
+            "laplacian" => Ok(Self::Laplacian),
+            "vertex" => Ok(Self::Vertex),
+            "none" => Ok(Self::None),
+            _ => Err(format!(
+                "unknown optimizer {s:?}: use local, global, laplacian, vertex or none"
+            )),
+        }
+    }
+}
+
+impl OptimizerMethod {
+    fn method(self) -> Method {
+        match self {
+            Self::Local => Method::Local,
+            Self::Global => Method::Global,
+            Self::Laplacian => Method::Laplacian,
+            Self::Vertex => Method::Vertex,
+            Self::None => Method::None,
+        }
+    }
+}
+
+/// The quality the optimiser maximises (`--metric`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MetricName {
+    /// Verdict's shape-and-size (shape and uniform size; default).
+    ShapeAndSize,
+    /// Verdict's shape.
+    Shape,
+}
+
+impl FromStr for MetricName {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "shape-and-size" => Ok(Self::ShapeAndSize),
+            "shape" => Ok(Self::Shape),
+            _ => Err(format!("unknown metric {s:?}: use shape-and-size or shape")),
         }
     }
 }
@@ -99,6 +165,10 @@ pub struct MeshOptions {
     pub pairing: PairingMethod,
     /// Element kind.
     pub elements: Elements,
+    /// How the quads are optimised.
+    pub optimizer: OptimizerMethod,
+    /// The quality the optimiser maximises.
+    pub metric: MetricName,
     /// Size of a pixel along x and y in the written mesh.
     pub pixel_size: [f64; 2],
     /// Largest image accepted, in pixels.
@@ -117,6 +187,8 @@ impl Default for MeshOptions {
             template_level: 1,
             pairing: PairingMethod::Matching,
             elements: Elements::Quad,
+            optimizer: OptimizerMethod::Local,
+            metric: MetricName::ShapeAndSize,
             pixel_size: [1.0, 1.0],
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
         }
@@ -141,6 +213,9 @@ pub enum PipelineError {
     /// The quad stage refused its input.
     #[error(transparent)]
     Quads(#[from] imesh_quad::QuadError),
+    /// The optimiser refused its input.
+    #[error(transparent)]
+    Optimise(#[from] imesh_optim::OptimError),
     /// The mesh broke an invariant (a bug: please report it with the image).
     #[error("the mesh is invalid ({0}); please report this with the image")]
     Invalid(String),
@@ -159,6 +234,8 @@ pub struct StageSeconds {
     pub curves: f64,
     /// DT', pairing, templates and adaptation (quads).
     pub quads: f64,
+    /// Optimisation of the quads.
+    pub optimise: f64,
     /// Invariant checks and quality measurement.
     pub check: f64,
     /// All stages.
@@ -236,6 +313,25 @@ impl MeshQuality {
     }
 }
 
+/// What the optimiser did (quads).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Optimisation {
+    /// The method.
+    pub method: OptimizerMethod,
+    /// The metric of the energy.
+    pub metric: MetricName,
+    /// Points free to move.
+    pub variables: usize,
+    /// Independent sets solved in parallel (local modes).
+    pub colours: usize,
+    /// Energy `Σ (1 − s)²` before.
+    pub energy_before: f64,
+    /// Energy after.
+    pub energy_after: f64,
+    /// Sweeps (local modes) or Powell iterations (global).
+    pub sweeps: usize,
+}
+
 /// The invariant checks' outcome.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Validation {
@@ -258,6 +354,12 @@ pub struct Report {
     pub label_agreement: f64,
     /// Quality statistics.
     pub quality: MeshQuality,
+    /// Quality statistics of the quads before optimisation (quads only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality_before_optimisation: Option<MeshQuality>,
+    /// What the optimiser did (quads only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optimisation: Option<Optimisation>,
     /// Invariant checks.
     pub validation: Validation,
 }
@@ -344,9 +446,10 @@ impl Pipeline {
             c_edges: segmented.c_edges.len(),
             ..Default::default()
         };
+        let mut optimised = None;
         let (vertices, elements, labels) = match o.elements {
             Elements::Tri => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
-            Elements::Quad => self.quads(&segmented, &mut counts, &mut seconds)?,
+            Elements::Quad => self.quads(&segmented, &mut counts, &mut seconds, &mut optimised)?,
         };
         let check = Instant::now();
         let checked = validate(
@@ -407,6 +510,10 @@ impl Pipeline {
             seconds,
             label_agreement,
             quality,
+            quality_before_optimisation: optimised
+                .as_ref()
+                .map(|(_, before)| MeshQuality::Quads(before.clone())),
+            optimisation: optimised.map(|(o, _)| o),
             validation: Validation {
                 valid: true,
                 area_ratio: checked.area / (f64::from(w) * f64::from(h)),
@@ -447,6 +554,7 @@ impl Pipeline {
         segmented: &SegmentedMesh,
         counts: &mut Counts,
         seconds: &mut StageSeconds,
+        optimised: &mut Option<(Optimisation, QuadQuality)>,
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
@@ -473,7 +581,7 @@ impl Pipeline {
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
         seconds.curves = start.elapsed().as_secs_f64();
-        let r = remesh(
+        let mut r = remesh(
             &simplified.graph,
             &curves,
             &QuadOptions {
@@ -503,6 +611,30 @@ impl Pipeline {
                 r.adaptation.invalid_left
             )));
         }
+        let optimisation = optimise(
+            &mut r,
+            &OptimOptions {
+                method: o.optimizer.method(),
+                metric: match o.metric {
+                    MetricName::ShapeAndSize => Metric::ShapeAndSize,
+                    MetricName::Shape => Metric::Shape,
+                },
+                ..OptimOptions::default()
+            },
+        )?;
+        seconds.optimise = optimisation.seconds;
+        *optimised = Some((
+            Optimisation {
+                method: o.optimizer,
+                metric: o.metric,
+                variables: optimisation.variables,
+                colours: optimisation.colours,
+                energy_before: optimisation.energy_before,
+                energy_after: optimisation.energy_after,
+                sweeps: optimisation.sweeps,
+            },
+            optimisation.before,
+        ));
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
         let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
         Ok((vertices, elements, r.mesh.labels))

@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use imesh::{Elements, MeshOptions, PairingMethod, Pipeline, PipelineResult};
+use imesh::{
+    Elements, MeshOptions, MetricName, OptimizerMethod, PairingMethod, Pipeline, PipelineResult,
+};
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
@@ -116,6 +118,13 @@ struct MeshFlags {
     /// Element kind: quad (all-quad mesh) or tri (the Imesh triangle mesh) [default: quad].
     #[arg(long)]
     elements: Option<Elements>,
+    /// Quad optimisation: local (control points, block by block), global (the paper's single
+    /// Powell run; slow), laplacian or vertex (baselines), none [default: local].
+    #[arg(long)]
+    optimizer: Option<OptimizerMethod>,
+    /// The quality the optimiser maximises: shape-and-size or shape [default: shape-and-size].
+    #[arg(long)]
+    metric: Option<MetricName>,
     /// Physical size of a pixel: SX or SX,SY.
     #[arg(long, value_parser = parse_pixel_size)]
     pixel_size: Option<[f64; 2]>,
@@ -192,6 +201,12 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(p) = args.pairing {
         o.pairing = p;
+    }
+    if let Some(m) = args.optimizer {
+        o.optimizer = m;
+    }
+    if let Some(m) = args.metric {
+        o.metric = m;
     }
     if let Some(n) = args.max_steiner {
         o.max_steiner = Some(n);

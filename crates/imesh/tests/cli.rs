@@ -208,6 +208,55 @@ fn the_triangle_mesh_and_quad_options() {
     let coarse = run(&["--tolerance", "5"], "t5.json");
     let edges = |r: &serde_json::Value| r["counts"]["simplified_edges"].as_u64().unwrap();
     assert!(edges(&coarse) < edges(&matching));
+    // Optimisation: the default (local, shape-and-size) reports the quality before it and
+    // lowers the energy; `none` leaves the mesh as the quad stage made it.
+    let energy = |r: &serde_json::Value, key: &str| r["optimisation"][key].as_f64().unwrap();
+    assert_eq!(matching["optimisation"]["method"], "local");
+    assert!(energy(&matching, "energy_after") < energy(&matching, "energy_before"));
+    let stat = |r: &serde_json::Value, block: &str, metric: &str, s: &str| {
+        r[block][metric][s].as_f64().unwrap()
+    };
+    assert!(
+        stat(&matching, "quality", "shape_and_size", "mean")
+            > stat(
+                &matching,
+                "quality_before_optimisation",
+                "shape_and_size",
+                "mean"
+            )
+    );
+    assert!(
+        stat(&matching, "quality", "shape_and_size", "min")
+            >= stat(
+                &matching,
+                "quality_before_optimisation",
+                "shape_and_size",
+                "min"
+            )
+    );
+    let none = run(&["--optimizer", "none"], "none.json");
+    for metric in ["shape_and_size", "shape", "scaled_jacobian"] {
+        for s in ["min", "mean"] {
+            let unoptimised = stat(&none, "quality", metric, s);
+            // Equal up to the order of parallel sums.
+            let close = |x: f64| (x - unoptimised).abs() <= 1e-12 * unoptimised.abs().max(1.0);
+            assert!(close(stat(&none, "quality_before_optimisation", metric, s)));
+            assert!(close(stat(
+                &matching,
+                "quality_before_optimisation",
+                metric,
+                s
+            )));
+        }
+    }
+    let shape = run(
+        &["--optimizer", "vertex", "--metric", "shape"],
+        "shape.json",
+    );
+    assert!(
+        stat(&shape, "quality", "shape", "mean")
+            > stat(&shape, "quality_before_optimisation", "shape", "mean")
+    );
 }
 
 #[test]
@@ -215,7 +264,7 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
     let image = image.to_str().unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 10] = [
         (&["mesh", "missing.png"], "missing.png"),
         (&["mesh", image, "-o", "out.obj"], ".msh"),
         (&["mesh", image, "--te", "2"], "t_e"),
@@ -224,6 +273,11 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--template-level", "9"], "1 to 8"),
         (&["mesh", image, "--tolerance=-1"], "tolerance"),
         (&["mesh", image, "--pairing", "best"], "greedy or matching"),
+        (&["mesh", image, "--optimizer", "newton"], "local, global"),
+        (
+            &["mesh", image, "--metric", "jacobian"],
+            "shape-and-size or shape",
+        ),
     ];
     for (args, hint) in cases {
         let out = imesh(args, dir.path());

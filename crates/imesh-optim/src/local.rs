@@ -1,0 +1,199 @@
+//! Block coordinate descent: each free point in turn minimises the energy of the quads it
+//! moves (two variables, by Powell's method), colour by colour so that the points of one colour
+//! are independent and can be solved in parallel, sweep after sweep until the energy stops
+//! falling.
+
+use argmin::core::{CostFunction, Error, Executor};
+use imesh_geom::Point;
+use rayon::prelude::*;
+
+use crate::energy::term;
+use crate::variables::Variables;
+use crate::{Powell, Setup};
+
+/// What one local solve sees: the corners of the quads it changes as `base + weight · δ`, and
+/// the neighbour-polygon edges its point must stay left of.
+struct LocalEnergy<'a> {
+    corners: &'a [[(Point, f64); 4]],
+    ring: &'a [[Point; 2]],
+    origin: Point,
+    setup: Setup<'a>,
+}
+
+/// `base + δ · w`, written once so that the solve and the update compute the same bits.
+#[inline]
+pub(crate) fn moved(base: Point, delta: Point, w: f64) -> Point {
+    if w == 0.0 {
+        base
+    } else {
+        Point::new(base.x + delta.x * w, base.y + delta.y * w)
+    }
+}
+
+impl LocalEnergy<'_> {
+    fn energy(&self, delta: Point) -> f64 {
+        let p = self.origin + delta;
+        if !self
+            .ring
+            .iter()
+            .all(|&[a, b]| imesh_geom::predicates::orient2d(a, b, p) > 0.0)
+        {
+            return f64::INFINITY;
+        }
+        let mut sum = 0.0;
+        for quad in self.corners {
+            let q = quad.map(|(base, w)| moved(base, delta, w));
+            match term(
+                &q,
+                self.setup.metric,
+                self.setup.average_area,
+                self.setup.floor,
+            ) {
+                Some(e) => sum += e,
+                None => return f64::INFINITY,
+            }
+        }
+        sum
+    }
+}
+
+impl CostFunction for LocalEnergy<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, x: &Vec<f64>) -> Result<f64, Error> {
+        Ok(self.energy(Point::new(x[0], x[1])))
+    }
+}
+
+/// Scratch buffers of one worker.
+#[derive(Default)]
+struct Scratch {
+    corners: Vec<[(Point, f64); 4]>,
+    ring: Vec<[Point; 2]>,
+}
+
+/// Where moving variable `i` lowers the energy of its quads: its best move, if any.
+fn solve(
+    variables: &Variables,
+    i: usize,
+    vertices: &[Point],
+    net: &[Point],
+    origin: Point,
+    setup: Setup<'_>,
+    scratch: &mut Scratch,
+) -> Option<Point> {
+    scratch.corners.clear();
+    let mut area = 0.0;
+    for &q in variables.quads.row(i) {
+        let quad = setup.quads[q as usize];
+        let corners = quad.map(|v| (vertices[v as usize], variables.weight(i, v)));
+        let p = corners.map(|(p, _)| p);
+        area +=
+            0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y));
+        scratch.corners.push(corners);
+    }
+    if scratch.corners.is_empty() {
+        return None;
+    }
+    scratch.ring.clear();
+    let ring = variables.ring.row(i);
+    let inside = ring.iter().all(|&[a, b]| {
+        imesh_geom::predicates::orient2d(net[a as usize], net[b as usize], origin) > 0.0
+    });
+    // A point already outside its neighbour polygon (next to a strongly curved boundary) is
+    // held to the quads' validity alone.
+    if inside {
+        scratch.ring.extend(
+            ring.iter()
+                .map(|&[a, b]| [net[a as usize], net[b as usize]]),
+        );
+    }
+    let local = LocalEnergy {
+        corners: &scratch.corners,
+        ring: &scratch.ring,
+        origin,
+        setup,
+    };
+    let start = local.energy(Point::new(0.0, 0.0));
+    if !start.is_finite() || start == 0.0 {
+        return None;
+    }
+    let size = (area / scratch.corners.len() as f64).abs().sqrt();
+    let powell = Powell::new(0.2 * size)
+        .with_tolerance(1e-4)
+        .with_line_search(1e-2, 10);
+    let result = Executor::new(local, powell)
+        .configure(|s| s.param(vec![0.0, 0.0]).max_iters(setup.local_iterations))
+        .run()
+        .ok()?;
+    let state = result.state();
+    let best = state.best_param.as_ref()?;
+    (state.best_cost < start).then(|| Point::new(best[0], best[1]))
+}
+
+/// Runs sweeps of local solves over `variables`, moving `vertices` (and, in control mode,
+/// `net`), and returns the number of sweeps run.
+pub(crate) fn descend(
+    variables: &Variables,
+    vertices: &mut [Point],
+    mut net: Option<&mut [Point]>,
+    setup: Setup<'_>,
+    total_energy: impl Fn(&[Point]) -> f64,
+) -> usize {
+    let mut energy = total_energy(vertices);
+    let mut sweeps = 0;
+    // Only points whose quads changed since they were last solved are solved again.
+    let mut dirty = vec![true; variables.len()];
+    let still = 1e-3 * setup.average_area.sqrt();
+    while sweeps < setup.max_sweeps {
+        sweeps += 1;
+        for colour in &variables.colours {
+            let moves: Vec<(usize, Point)> = {
+                let (vertices, net_view): (&[Point], &[Point]) =
+                    (vertices, net.as_deref().unwrap_or(&[]));
+                colour
+                    .par_iter()
+                    .filter(|&&i| dirty[i as usize])
+                    .map_init(Scratch::default, |scratch, &i| {
+                        let i = i as usize;
+                        let id = variables.ids[i] as usize;
+                        let origin = if net_view.is_empty() {
+                            vertices[id]
+                        } else {
+                            net_view[id]
+                        };
+                        solve(variables, i, vertices, net_view, origin, setup, scratch)
+                            .map(|d| (i, d))
+                    })
+                    .flatten()
+                    .collect()
+            };
+            for &i in colour {
+                dirty[i as usize] = false;
+            }
+            for (i, delta) in moves {
+                if delta.x.abs().max(delta.y.abs()) > still {
+                    for &q in variables.quads.row(i) {
+                        for &j in variables.by_quad.row(q as usize) {
+                            dirty[j as usize] = true;
+                        }
+                    }
+                }
+                for &(v, w) in variables.influence.row(i) {
+                    vertices[v as usize] = moved(vertices[v as usize], delta, w);
+                }
+                if let Some(net) = net.as_deref_mut() {
+                    let c = variables.ids[i] as usize;
+                    net[c] = net[c] + delta;
+                }
+            }
+        }
+        let next = total_energy(vertices);
+        let drop = energy - next;
+        energy = next;
+        if drop <= setup.tolerance * energy.max(f64::MIN_POSITIVE) || !dirty.contains(&true) {
+            break;
+        }
+    }
+    sweeps
+}

@@ -1,0 +1,233 @@
+//! The optimiser on fixture meshes and random label images: lower energy, valid quads, fixed
+//! boundaries, never a worse worst quad, and the same result on any number of threads.
+
+use std::path::Path;
+
+use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
+use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
+use imesh_geom::Point;
+use imesh_optim::{optimise, Method, Metric, OptimOptions, OptimReport};
+use imesh_quad::{remesh, QuadOptions, Remesh};
+use proptest::prelude::*;
+
+#[path = "../../imesh-curves/tests/support/mod.rs"]
+mod support;
+
+fn fixture(name: &str) -> LabelGrid {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name);
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    if name.contains("labels") {
+        return label_map(&image, 256).unwrap();
+    }
+    let grey = luminance(&image);
+    threshold(&grey, &multi_otsu_levels(&grey, 3))
+}
+
+fn quad_mesh(grid: &LabelGrid) -> Remesh {
+    let g = support::imesh_boundaries(grid);
+    let s = simplify(&g, &SimplifyOptions { tolerance: 2.0 }).unwrap();
+    let fits = fit_edges(&s, &g, &FitOptions::default());
+    let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
+    remesh(&s.graph, &curves, &QuadOptions::default()).unwrap()
+}
+
+/// A 48 × 40 image: a disc, a rotated square and a thin bar on a background.
+fn small_grid() -> LabelGrid {
+    let (w, h) = (48u32, 40u32);
+    let labels = (0..w * h)
+        .map(|i| {
+            let (x, y) = (f64::from(i % w) + 0.5, f64::from(i / w) + 0.5);
+            if (x - 14.0).powi(2) + (y - 14.0).powi(2) < 64.0 {
+                1
+            } else if (x - 34.0 + y - 24.0).abs() + (x - 34.0 - y + 24.0).abs() < 14.0 {
+                2
+            } else if (30.0..33.0).contains(&y) && x < 20.0 {
+                3
+            } else {
+                0
+            }
+        })
+        .collect();
+    support::grid(w, h, labels)
+}
+
+/// The points optimisation must not move: control points on constrained M edges, and the quad
+/// vertices on them.
+fn constrained(r: &Remesh) -> (Vec<usize>, Vec<usize>) {
+    let t = &r.dt.triangulation;
+    let (mut controls, mut vertices) = (Vec::new(), Vec::new());
+    for (e, &h) in r.elements.edges.iter().enumerate() {
+        if t.is_constrained(h) {
+            controls.push(t.origin(h).index());
+            controls.push(t.destination(h).index());
+            controls.extend(r.net.edge_inner(e as u32).map(|c| c as usize));
+            vertices.extend(
+                r.mesh
+                    .edge_vertices(t, &r.elements, e as u32)
+                    .into_iter()
+                    .map(|v| v as usize),
+            );
+        }
+    }
+    (controls, vertices)
+}
+
+fn area(r: &Remesh) -> f64 {
+    r.mesh.area()
+}
+
+/// Runs `method` on a copy of `start` and checks every promise of the optimiser.
+fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport) {
+    let mut r = start.clone();
+    let options = OptimOptions {
+        method,
+        metric,
+        global_iterations: 2,
+        ..OptimOptions::default()
+    };
+    let report = optimise(&mut r, &options).unwrap();
+    for q in 0..r.mesh.quads.len() {
+        assert!(r.mesh.is_valid(q), "{method:?}: quad {q} invalid");
+    }
+    let (controls, vertices) = constrained(start);
+    for v in vertices {
+        assert_eq!(
+            r.mesh.vertices[v], start.mesh.vertices[v],
+            "{method:?} moved vertex {v}"
+        );
+    }
+    if matches!(method, Method::Local | Method::Global) {
+        for c in controls {
+            assert_eq!(
+                r.net.points[c], start.net.points[c],
+                "{method:?} moved control {c}"
+            );
+        }
+    }
+    let a = area(start);
+    assert!(
+        (area(&r) - a).abs() <= 1e-9 * a,
+        "{method:?} changed the area"
+    );
+    assert_eq!(r.mesh.quads, start.mesh.quads);
+    if method != Method::Laplacian {
+        assert!(
+            report.energy_after <= report.energy_before,
+            "{method:?}: {report:?}"
+        );
+        let (before, after) = match metric {
+            Metric::ShapeAndSize => (&report.before.shape_and_size, &report.after.shape_and_size),
+            Metric::Shape => (&report.before.shape, &report.after.shape),
+        };
+        assert!(
+            after.min >= before.min,
+            "{method:?}: worst fell {} → {}",
+            before.min,
+            after.min
+        );
+    }
+    (r, report)
+}
+
+#[test]
+fn local_and_global_lower_the_energy_of_a_small_mesh() {
+    let start = quad_mesh(&small_grid());
+    let (_, local) = check(&start, Method::Local, Metric::ShapeAndSize);
+    let (_, global) = check(&start, Method::Global, Metric::ShapeAndSize);
+    assert!(local.energy_after < 0.9 * local.energy_before, "{local:?}");
+    assert!(
+        global.energy_after < 0.95 * global.energy_before,
+        "{global:?}"
+    );
+    assert!(local.variables > 0 && local.colours > 1);
+}
+
+#[test]
+fn every_method_keeps_fixture_meshes_valid_and_their_boundaries_fixed() {
+    for name in [
+        "stardist-mask2d_labels.png",
+        "pyvista-channels_z050_labels.png",
+    ] {
+        let start = quad_mesh(&fixture(name));
+        let (_, local) = check(&start, Method::Local, Metric::ShapeAndSize);
+        assert!(
+            local.energy_after < local.energy_before,
+            "{name}: {local:?}"
+        );
+        let (_, shape) = check(&start, Method::Local, Metric::Shape);
+        assert!(
+            shape.after.shape.mean > shape.before.shape.mean + 0.05,
+            "{name}: shape {} → {}",
+            shape.before.shape.mean,
+            shape.after.shape.mean
+        );
+        let (_, vertex) = check(&start, Method::Vertex, Metric::ShapeAndSize);
+        assert!(vertex.energy_after < vertex.energy_before, "{name}");
+        check(&start, Method::Laplacian, Metric::ShapeAndSize);
+        let (none_mesh, none) = check(&start, Method::None, Metric::ShapeAndSize);
+        assert_eq!(none.energy_after, none.energy_before);
+        assert_eq!(none_mesh.mesh.vertices, start.mesh.vertices);
+    }
+}
+
+#[test]
+fn results_are_identical_on_one_and_two_threads() {
+    let start = quad_mesh(&fixture("stardist-mask2d_labels.png"));
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut r = start.clone();
+            optimise(&mut r, &OptimOptions::default()).unwrap();
+            r
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.mesh.vertices, two.mesh.vertices);
+    assert_eq!(one.net.points, two.net.points);
+    assert_ne!(one.mesh.vertices, start.mesh.vertices);
+}
+
+#[test]
+fn the_control_points_follow_the_quad_vertices() {
+    // After optimisation every quad vertex is still its patch at its canonical coordinates
+    // (up to rounding): the mesh remains the evaluation of the optimised Bézier patches.
+    let start = quad_mesh(&small_grid());
+    let (r, _) = check(&start, Method::Local, Metric::ShapeAndSize);
+    let mut evaluated = r.mesh.clone();
+    for k in 0..r.elements.elements.len() {
+        evaluated.evaluate_element(&r.elements, &r.net, k);
+    }
+    for (a, b) in evaluated.vertices.iter().zip(&r.mesh.vertices) {
+        assert!(a.distance_squared(*b) < 1e-18, "{a:?} vs {b:?}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_label_images_optimise_without_breaking_anything(
+        w in 3u32..14, h in 3u32..14, seed in any::<u64>(), labels in 2u32..4,
+    ) {
+        let mut state = seed | 1;
+        let cells = (0..w * h)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state % u64::from(labels)) as u32
+            })
+            .collect();
+        let start = quad_mesh(&support::grid(w, h, cells));
+        let (r, report) = check(&start, Method::Local, Metric::ShapeAndSize);
+        prop_assert!(report.energy_after <= report.energy_before);
+        prop_assert_eq!(r.mesh.labels, start.mesh.labels);
+        let origin = Point::new(0.0, 0.0);
+        prop_assert!(r.mesh.vertices.iter().all(|p| p.distance_squared(origin).is_finite()));
+    }
+}
