@@ -3,11 +3,13 @@
 //! ```text
 //! cargo xtask bench delaunay [--runs N] [--quick]
 //! cargo xtask bench refine [--runs N]
+//! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask fixtures quality
 //! ```
 
 mod alloc;
 mod bench_delaunay;
+mod bench_optim;
 mod bench_refine;
 mod fixtures;
 
@@ -15,6 +17,7 @@ use std::process::ExitCode;
 
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
+       cargo xtask bench optim [--global-iterations N]
        cargo xtask fixtures quality
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
@@ -25,6 +28,11 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
   bench refine     Ruppert refinement of fixture label boundaries and a random planar graph at
                    20.7°, 28° and 33°: ours against spade (and Triangle with --features triangle);
                    writes target/bench/refine.json
+
+  bench optim      the quad optimisers (none, laplacian, vertex, local; global on the small
+                   fixtures) through the whole pipeline: worst / mean quality and seconds;
+                   writes target/bench/optim.json
+    --global-iterations N   Powell iterations of the global mode (default 3)
 
   fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
                    vtkMeshQuality, installed from PyPI into target/venv-vtk";
@@ -75,6 +83,18 @@ fn run(args: &[String]) -> Result<(), String> {
                 _ => return Err(format!("unknown options '{}'", rest.join(" "))),
             };
             bench_refine::run(runs)
+        }
+        ["bench", "optim", rest @ ..] => {
+            let iterations = match rest {
+                [] => 3,
+                ["--global-iterations", n] => {
+                    n.parse().ok().filter(|&r: &u64| r > 0).ok_or_else(|| {
+                        format!("--global-iterations takes a positive integer, not '{n}'")
+                    })?
+                }
+                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+            };
+            bench_optim::run(iterations)
         }
         ["fixtures", "quality"] => fixtures::quality(),
         [] | ["help"] | ["--help"] | ["-h"] => {

@@ -1,4 +1,4 @@
-//! The energy `q_s = Σ (1 − s(ν))²` and the feasibility of one quad.
+//! The quality the energy is built on, and the validity of one quad.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -39,15 +39,4 @@ impl Metric {
 #[inline]
 pub fn is_valid(p: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) > 0.0)
-}
-
-/// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or its quality
-/// falls below `floor`.
-#[inline]
-pub fn term(p: &[Point; 4], metric: Metric, average_area: f64, floor: f64) -> Option<f64> {
-    if !is_valid(p) {
-        return None;
-    }
-    let s = metric.value(p, average_area);
-    (s >= floor).then_some((1.0 - s) * (1.0 - s))
 }

@@ -10,7 +10,6 @@ use argmin::core::{CostFunction, Error, Executor};
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 
-use crate::energy::term;
 use crate::variables::Variables;
 use crate::{Powell, Setup};
 
@@ -110,12 +109,7 @@ impl GlobalEnergy<'_> {
         let mut energy = cache.energy;
         for &q in &quads {
             let p = self.setup.quads[q as usize].map(position);
-            match term(
-                &p,
-                self.setup.metric,
-                self.setup.average_area,
-                self.setup.floor,
-            ) {
+            match self.setup.term(&p) {
                 Some(e) => {
                     energy += e - cache.terms[q as usize];
                     new_terms.push(e);

@@ -157,8 +157,11 @@ pub(crate) struct Setup<'a> {
     pub quads: &'a [[u32; 4]],
     pub metric: Metric,
     pub average_area: f64,
-    /// No quad may fall below this quality (the start's worst).
+    /// No quad may fall below this quality (the start's worst)...
     pub floor: f64,
+    /// ... nor below this shape (the start's worst), whatever the metric: sizes are never
+    /// evened out at the price of the worst shape.
+    pub shape_floor: f64,
     pub max_sweeps: usize,
     pub tolerance: f64,
     pub local_iterations: u64,
@@ -169,6 +172,24 @@ impl Setup<'_> {
     pub fn value(&self, vertices: &[Point], q: usize) -> f64 {
         let p = self.quads[q].map(|v| vertices[v as usize]);
         self.metric.value(&p, self.average_area)
+    }
+
+    /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
+    /// below a floor.
+    #[inline]
+    pub fn term(&self, p: &[Point; 4]) -> Option<f64> {
+        if !is_valid(p) {
+            return None;
+        }
+        let q = p.map(|p| [p.x, p.y]);
+        let shape = imesh_quality::quad::shape(&q);
+        let s = match self.metric {
+            Metric::Shape => shape,
+            Metric::ShapeAndSize => {
+                shape * imesh_quality::quad::relative_size_squared(&q, self.average_area)
+            }
+        };
+        (s >= self.floor && shape >= self.shape_floor).then_some((1.0 - s) * (1.0 - s))
     }
 
     /// The whole energy over `vertices`. The terms are computed in parallel but summed in
@@ -218,6 +239,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         metric: options.metric,
         average_area,
         floor: 0.0,
+        shape_floor: 0.0,
         max_sweeps: options.max_sweeps,
         tolerance: options.tolerance,
         local_iterations: options.local_iterations.max(1),
@@ -226,6 +248,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         .into_par_iter()
         .map(|q| setup.value(&mesh.vertices, q))
         .reduce(|| f64::INFINITY, f64::min);
+    setup.shape_floor = before.shape.min;
     let energy_before = setup.energy(&mesh.vertices);
     let t = &dt.triangulation;
     let (variables, colours, sweeps) = match options.method {

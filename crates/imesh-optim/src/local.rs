@@ -7,7 +7,6 @@ use argmin::core::{CostFunction, Error, Executor};
 use imesh_geom::Point;
 use rayon::prelude::*;
 
-use crate::energy::term;
 use crate::variables::Variables;
 use crate::{Powell, Setup};
 
@@ -43,12 +42,7 @@ impl LocalEnergy<'_> {
         let mut sum = 0.0;
         for quad in self.corners {
             let q = quad.map(|(base, w)| moved(base, delta, w));
-            match term(
-                &q,
-                self.setup.metric,
-                self.setup.average_area,
-                self.setup.floor,
-            ) {
+            match self.setup.term(&q) {
                 Some(e) => sum += e,
                 None => return f64::INFINITY,
             }

@@ -169,6 +169,8 @@ pub struct MeshOptions {
     pub optimizer: OptimizerMethod,
     /// The quality the optimiser maximises.
     pub metric: MetricName,
+    /// Most Powell iterations of the global optimiser.
+    pub global_iterations: u64,
     /// Size of a pixel along x and y in the written mesh.
     pub pixel_size: [f64; 2],
     /// Largest image accepted, in pixels.
@@ -189,6 +191,7 @@ impl Default for MeshOptions {
             elements: Elements::Quad,
             optimizer: OptimizerMethod::Local,
             metric: MetricName::ShapeAndSize,
+            global_iterations: OptimOptions::default().global_iterations,
             pixel_size: [1.0, 1.0],
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
         }
@@ -288,6 +291,14 @@ pub enum MeshQuality {
 }
 
 impl MeshQuality {
+    /// Shape-and-size statistics (quads only).
+    pub fn shape_and_size(&self) -> Option<&Statistics> {
+        match self {
+            Self::Quads(q) => Some(&q.shape_and_size),
+            Self::Triangles(_) => None,
+        }
+    }
+
     /// Shape statistics.
     pub fn shape(&self) -> &Statistics {
         match self {
@@ -619,6 +630,7 @@ impl Pipeline {
                     MetricName::ShapeAndSize => Metric::ShapeAndSize,
                     MetricName::Shape => Metric::Shape,
                 },
+                global_iterations: o.global_iterations,
                 ..OptimOptions::default()
             },
         )?;
