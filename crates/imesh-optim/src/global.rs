@@ -109,7 +109,7 @@ impl GlobalEnergy<'_> {
         let mut energy = cache.energy;
         for &q in &quads {
             let p = self.setup.quads[q as usize].map(position);
-            match self.setup.term(&p) {
+            match self.setup.term(q as usize, &p) {
                 Some(e) => {
                     energy += e - cache.terms[q as usize];
                     new_terms.push(e);

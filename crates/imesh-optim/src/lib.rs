@@ -8,8 +8,10 @@
 //!
 //! A move is feasible only if every quad keeps positive Jacobians at its four corners (exact
 //! orientation), every moved control point stays strictly inside the polygon of its
-//! neighbours in the control net, and no quad falls below the mesh's starting worst quality:
-//! the result is never worse than the start.
+//! neighbours in the control net, no quad falls below the mesh's starting worst quality, and
+//! no quad's shape falls below its own start shape or [`OptimOptions::keep_shape`], whichever
+//! is lower: the result is never worse than the start, and sizes are evened out (shape-and-size)
+//! only where shapes allow.
 //!
 //! [`Method`]s: [`Method::Local`] (default) is block coordinate descent, one control point at a
 //! time by [`Powell`]'s method, points coloured so that one colour shares no quad and is solved
@@ -80,6 +82,17 @@ pub enum Method {
     Global,
 }
 
+/// How each local solve (two variables) is minimised.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LocalSolver {
+    /// [`Powell`]'s method (derivative-free; default).
+    #[default]
+    Powell,
+    /// argmin's L-BFGS with the analytic gradient of the local energy and a backtracking
+    /// (Armijo) line search.
+    Lbfgs,
+}
+
 /// Options of [`optimise`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OptimOptions {
@@ -91,10 +104,16 @@ pub struct OptimOptions {
     pub tolerance: f64,
     /// Most sweeps (local, vertex and Laplacian modes).
     pub max_sweeps: usize,
-    /// Most Powell iterations of each local solve.
+    /// The minimiser of each local solve.
+    pub local_solver: LocalSolver,
+    /// Most Powell iterations of each local solve (twice as many L-BFGS ones).
     pub local_iterations: u64,
     /// Most Powell iterations of the global run.
     pub global_iterations: u64,
+    /// No quad whose shape is at least this may fall below it, and no other quad below its
+    /// start shape: with shape-and-size, sizes are evened out only where shapes allow. 0 leaves
+    /// only the global guard (no quad below the start's worst shape).
+    pub keep_shape: f64,
 }
 
 impl Default for OptimOptions {
@@ -104,8 +123,10 @@ impl Default for OptimOptions {
             metric: Metric::ShapeAndSize,
             tolerance: 1e-2,
             max_sweeps: 40,
+            local_solver: LocalSolver::Powell,
             local_iterations: 1,
             global_iterations: 20,
+            keep_shape: 0.5,
         }
     }
 }
@@ -159,12 +180,14 @@ pub(crate) struct Setup<'a> {
     pub average_area: f64,
     /// No quad may fall below this quality (the start's worst)...
     pub floor: f64,
-    /// ... nor below this shape (the start's worst), whatever the metric: sizes are never
-    /// evened out at the price of the worst shape.
-    pub shape_floor: f64,
+    /// ... and quad `q` not below shape `shape_floors[q]` (its own start shape, or
+    /// [`OptimOptions::keep_shape`] if that is lower, but never below the start's worst),
+    /// whatever the metric: sizes are never evened out by spoiling shapes.
+    pub shape_floors: &'a [f64],
     pub max_sweeps: usize,
     pub tolerance: f64,
     pub local_iterations: u64,
+    pub local_solver: LocalSolver,
 }
 
 impl Setup<'_> {
@@ -177,7 +200,7 @@ impl Setup<'_> {
     /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
     /// below a floor.
     #[inline]
-    pub fn term(&self, p: &[Point; 4]) -> Option<f64> {
+    pub fn term(&self, quad: usize, p: &[Point; 4]) -> Option<f64> {
         if !is_valid(p) {
             return None;
         }
@@ -189,7 +212,60 @@ impl Setup<'_> {
                 shape * imesh_quality::quad::relative_size_squared(&q, self.average_area)
             }
         };
-        (s >= self.floor && shape >= self.shape_floor).then_some((1.0 - s) * (1.0 - s))
+        (s >= self.floor && shape >= self.shape_floors[quad]).then_some((1.0 - s) * (1.0 - s))
+    }
+
+    /// The energy term of quad `p` and its gradient with respect to each corner (`None` where
+    /// [`Setup::term`] is). Shape is the minimum over the corners: its gradient is that of the
+    /// worst corner (a subgradient where two tie).
+    pub fn term_gradient(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, [Point; 4])> {
+        let e = self.term(quad, p)?;
+        let q = p.map(|p| [p.x, p.y]);
+        let shape = imesh_quality::quad::shape(&q);
+        let mut worst = (f64::INFINITY, 0);
+        for k in 0..4 {
+            let (u, c, v) = (p[(k + 3) % 4], p[k], p[(k + 1) % 4]);
+            let (a, b) = (c - u, v - c);
+            let f = 2.0 * (a.x * b.y - a.y * b.x) / (a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y);
+            if f < worst.0 {
+                worst = (f, k);
+            }
+        }
+        // ∂shape/∂p at the worst corner k: shape = 2α / D, α = a × b, D = |a|² + |b|², with
+        // a = p_k − p_{k−1} and b = p_{k+1} − p_k.
+        let k = worst.1;
+        let (u, c, v) = (p[(k + 3) % 4], p[k], p[(k + 1) % 4]);
+        let (a, b) = (c - u, v - c);
+        let alpha = a.x * b.y - a.y * b.x;
+        let d = a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y;
+        let scale = 2.0 / (d * d);
+        let da = Point::new(b.y * d - 2.0 * alpha * a.x, -b.x * d - 2.0 * alpha * a.y) * scale;
+        let db = Point::new(-a.y * d - 2.0 * alpha * b.x, a.x * d - 2.0 * alpha * b.y) * scale;
+        let mut ds = [Point::new(0.0, 0.0); 4];
+        ds[(k + 3) % 4] = da * -1.0;
+        ds[k] = da - db;
+        ds[(k + 1) % 4] = db;
+        let s = match self.metric {
+            Metric::Shape => shape,
+            Metric::ShapeAndSize => {
+                // relative size min(R, 1/R)², R = area / Ā, ∂area/∂p_i = ½ (y_{i+1} − y_{i−1},
+                // x_{i−1} − x_{i+1}).
+                let area = imesh_quality::quad::area(&q);
+                let r = area / self.average_area;
+                let (rel, drel) = if r < 1.0 {
+                    (r * r, 2.0 * r)
+                } else {
+                    (1.0 / (r * r), -2.0 / (r * r * r))
+                };
+                for i in 0..4 {
+                    let (next, prev) = (p[(i + 1) % 4], p[(i + 3) % 4]);
+                    let darea = Point::new(next.y - prev.y, prev.x - next.x) * 0.5;
+                    ds[i] = ds[i] * rel + darea * (shape * drel / self.average_area);
+                }
+                shape * rel
+            }
+        };
+        Some((e, ds.map(|g| g * (-2.0 * (1.0 - s)))))
     }
 
     /// The whole energy over `vertices`. The terms are computed in parallel but summed in
@@ -229,6 +305,15 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     }
     let before = quality(&mesh.vertices, &mesh.quads);
     let quads = mesh.quads.clone();
+    let shape_floors: Vec<f64> = quads
+        .par_iter()
+        .map(|q| {
+            let p = q.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
+            imesh_quality::quad::shape(&p)
+                .min(options.keep_shape)
+                .max(before.shape.min)
+        })
+        .collect();
     let average_area = if quads.is_empty() {
         0.0
     } else {
@@ -239,16 +324,16 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         metric: options.metric,
         average_area,
         floor: 0.0,
-        shape_floor: 0.0,
+        shape_floors: &shape_floors,
         max_sweeps: options.max_sweeps,
         tolerance: options.tolerance,
         local_iterations: options.local_iterations.max(1),
+        local_solver: options.local_solver,
     };
     setup.floor = (0..quads.len())
         .into_par_iter()
         .map(|q| setup.value(&mesh.vertices, q))
         .reduce(|| f64::INFINITY, f64::min);
-    setup.shape_floor = before.shape.min;
     let energy_before = setup.energy(&mesh.vertices);
     let t = &dt.triangulation;
     let (variables, colours, sweeps) = match options.method {
@@ -303,4 +388,92 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         before,
         after,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The analytic gradient of a term against central differences.
+    fn check_gradient(metric: Metric, p: [Point; 4]) -> Result<(), TestCaseError> {
+        let quads = [[0, 1, 2, 3]];
+        let setup = Setup {
+            quads: &quads,
+            metric,
+            average_area: 1.3,
+            floor: 0.0,
+            shape_floors: &[0.0],
+            max_sweeps: 1,
+            tolerance: 0.0,
+            local_iterations: 1,
+            local_solver: LocalSolver::Powell,
+        };
+        let Some((_, gradient)) = setup.term_gradient(0, &p) else {
+            return Ok(());
+        };
+        let h = 1e-6;
+        for i in 0..4 {
+            for axis in 0..2 {
+                let step = if axis == 0 {
+                    Point::new(h, 0.0)
+                } else {
+                    Point::new(0.0, h)
+                };
+                let (mut plus, mut minus) = (p, p);
+                plus[i] = plus[i] + step;
+                minus[i] = minus[i] - step;
+                let (Some(a), Some(b)) = (setup.term(0, &plus), setup.term(0, &minus)) else {
+                    continue;
+                };
+                let numeric = (a - b) / (2.0 * h);
+                let analytic = if axis == 0 {
+                    gradient[i].x
+                } else {
+                    gradient[i].y
+                };
+                // The shape is a minimum over corners: skip points where the worst corner changes
+                // within the step (the one-sided slopes differ there).
+                let kink = {
+                    let worst = |q: &[Point; 4]| {
+                        (0..4)
+                            .map(|k| {
+                                let (u, c, v) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+                                let (a, b) = (c - u, v - c);
+                                let f = 2.0 * (a.x * b.y - a.y * b.x)
+                                    / (a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y);
+                                (f, k)
+                            })
+                            .fold((f64::INFINITY, 0), |m, x| if x.0 < m.0 { x } else { m })
+                            .1
+                    };
+                    worst(&plus) != worst(&minus)
+                };
+                if !kink {
+                    prop_assert!(
+                        (numeric - analytic).abs() <= 1e-5 * (1.0 + numeric.abs()),
+                        "corner {i} axis {axis}: {numeric} vs {analytic}"
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #[test]
+        fn term_gradients_match_central_differences(
+            jitter in proptest::collection::vec(-0.3f64..0.3, 8), scale in 0.5f64..2.0,
+        ) {
+            let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+            let p: [Point; 4] = std::array::from_fn(|i| {
+                Point::new(
+                    (square[i].0 + jitter[2 * i]) * scale,
+                    (square[i].1 + jitter[2 * i + 1]) * scale,
+                )
+            });
+            check_gradient(Metric::ShapeAndSize, p)?;
+            check_gradient(Metric::Shape, p)?;
+        }
+    }
 }

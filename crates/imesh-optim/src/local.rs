@@ -3,17 +3,20 @@
 //! are independent and can be solved in parallel, sweep after sweep until the energy stops
 //! falling.
 
-use argmin::core::{CostFunction, Error, Executor};
+use argmin::core::{CostFunction, Error, Executor, Gradient, State};
+use argmin::solver::linesearch::condition::ArmijoCondition;
+use argmin::solver::linesearch::BacktrackingLineSearch;
+use argmin::solver::quasinewton::LBFGS;
 use imesh_geom::Point;
 use rayon::prelude::*;
 
 use crate::variables::Variables;
-use crate::{Powell, Setup};
+use crate::{LocalSolver, Powell, Setup};
 
 /// What one local solve sees: the corners of the quads it changes as `base + weight · δ`, and
 /// the neighbour-polygon edges its point must stay left of.
 struct LocalEnergy<'a> {
-    corners: &'a [[(Point, f64); 4]],
+    corners: &'a [(usize, [(Point, f64); 4])],
     ring: &'a [[Point; 2]],
     origin: Point,
     setup: Setup<'a>,
@@ -40,14 +43,39 @@ impl LocalEnergy<'_> {
             return f64::INFINITY;
         }
         let mut sum = 0.0;
-        for quad in self.corners {
+        for (k, quad) in self.corners {
             let q = quad.map(|(base, w)| moved(base, delta, w));
-            match self.setup.term(&q) {
+            match self.setup.term(*k, &q) {
                 Some(e) => sum += e,
                 None => return f64::INFINITY,
             }
         }
         sum
+    }
+}
+
+impl LocalEnergy<'_> {
+    /// The gradient of [`LocalEnergy::energy`] (zero where that is infinite).
+    fn gradient(&self, delta: Point) -> Point {
+        let mut g = Point::new(0.0, 0.0);
+        for (k, quad) in self.corners {
+            let q = quad.map(|(base, w)| moved(base, delta, w));
+            if let Some((_, d)) = self.setup.term_gradient(*k, &q) {
+                for (corner, (_, w)) in d.iter().zip(quad) {
+                    g = g + *corner * *w;
+                }
+            }
+        }
+        g
+    }
+}
+
+impl Gradient for LocalEnergy<'_> {
+    type Param = Vec<f64>;
+    type Gradient = Vec<f64>;
+    fn gradient(&self, x: &Vec<f64>) -> Result<Vec<f64>, Error> {
+        let g = LocalEnergy::gradient(self, Point::new(x[0], x[1]));
+        Ok(vec![g.x, g.y])
     }
 }
 
@@ -62,7 +90,7 @@ impl CostFunction for LocalEnergy<'_> {
 /// Scratch buffers of one worker.
 #[derive(Default)]
 struct Scratch {
-    corners: Vec<[(Point, f64); 4]>,
+    corners: Vec<(usize, [(Point, f64); 4])>,
     ring: Vec<[Point; 2]>,
 }
 
@@ -84,7 +112,7 @@ fn solve(
         let p = corners.map(|(p, _)| p);
         area +=
             0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y));
-        scratch.corners.push(corners);
+        scratch.corners.push((q as usize, corners));
     }
     if scratch.corners.is_empty() {
         return None;
@@ -113,16 +141,33 @@ fn solve(
         return None;
     }
     let size = (area / scratch.corners.len() as f64).abs().sqrt();
-    let powell = Powell::new(0.2 * size)
-        .with_tolerance(1e-4)
-        .with_line_search(1e-2, 10);
-    let result = Executor::new(local, powell)
-        .configure(|s| s.param(vec![0.0, 0.0]).max_iters(setup.local_iterations))
-        .run()
-        .ok()?;
-    let state = result.state();
-    let best = state.best_param.as_ref()?;
-    (state.best_cost < start).then(|| Point::new(best[0], best[1]))
+    let (best, cost) = match setup.local_solver {
+        LocalSolver::Powell => {
+            let powell = Powell::new(0.2 * size)
+                .with_tolerance(1e-4)
+                .with_line_search(1e-2, 10);
+            let result = Executor::new(local, powell)
+                .configure(|s| s.param(vec![0.0, 0.0]).max_iters(setup.local_iterations))
+                .run()
+                .ok()?;
+            let state = result.state();
+            (state.get_best_param()?.clone(), state.get_best_cost())
+        }
+        LocalSolver::Lbfgs => {
+            let line = BacktrackingLineSearch::new(ArmijoCondition::new(1e-4).ok()?);
+            let lbfgs = LBFGS::new(line, 3);
+            let result = Executor::new(local, lbfgs)
+                .configure(|s| {
+                    s.param(vec![0.0, 0.0])
+                        .max_iters(2 * setup.local_iterations)
+                })
+                .run()
+                .ok()?;
+            let state = result.state();
+            (state.get_best_param()?.clone(), state.get_best_cost())
+        }
+    };
+    (cost < start).then(|| Point::new(best[0], best[1]))
 }
 
 /// Runs sweeps of local solves over `variables`, moving `vertices` (and, in control mode,
