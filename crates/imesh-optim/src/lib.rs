@@ -194,7 +194,27 @@ impl Setup<'_> {
     /// The metric of quad `q` over `vertices`.
     pub fn value(&self, vertices: &[Point], q: usize) -> f64 {
         let p = self.quads[q].map(|v| vertices[v as usize]);
-        self.metric.value(&p, self.average_area)
+        self.quality(&p).0
+    }
+
+    /// The metric `s` and the shape of quad `p`, in one pass: Verdict's shape, and the relative
+    /// size from the shoelace area (Verdict's `¼ Σ α_k`, the same area up to rounding), so that
+    /// every energy term, floor and gradient here agrees to the bit.
+    #[inline]
+    pub fn quality(&self, p: &[Point; 4]) -> (f64, f64) {
+        let shape = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
+        let s = match self.metric {
+            Metric::Shape => shape,
+            Metric::ShapeAndSize => {
+                let area = 0.5
+                    * ((p[2].x - p[0].x) * (p[3].y - p[1].y)
+                        - (p[3].x - p[1].x) * (p[2].y - p[0].y));
+                let r = area / self.average_area;
+                let m = if r > 0.0 { r.min(1.0 / r) } else { 0.0 };
+                shape * m * m
+            }
+        };
+        (s, shape)
     }
 
     /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
@@ -204,14 +224,7 @@ impl Setup<'_> {
         if !is_valid(p) {
             return None;
         }
-        let q = p.map(|p| [p.x, p.y]);
-        let shape = imesh_quality::quad::shape(&q);
-        let s = match self.metric {
-            Metric::Shape => shape,
-            Metric::ShapeAndSize => {
-                shape * imesh_quality::quad::relative_size_squared(&q, self.average_area)
-            }
-        };
+        let (s, shape) = self.quality(p);
         (s >= self.floor && shape >= self.shape_floors[quad]).then_some((1.0 - s) * (1.0 - s))
     }
 
@@ -220,8 +233,7 @@ impl Setup<'_> {
     /// worst corner (a subgradient where two tie).
     pub fn term_gradient(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, [Point; 4])> {
         let e = self.term(quad, p)?;
-        let q = p.map(|p| [p.x, p.y]);
-        let shape = imesh_quality::quad::shape(&q);
+        let shape = self.quality(p).1;
         let mut worst = (f64::INFINITY, 0);
         for k in 0..4 {
             let (u, c, v) = (p[(k + 3) % 4], p[k], p[(k + 1) % 4]);
@@ -250,7 +262,9 @@ impl Setup<'_> {
             Metric::ShapeAndSize => {
                 // relative size min(R, 1/R)², R = area / Ā, ∂area/∂p_i = ½ (y_{i+1} − y_{i−1},
                 // x_{i−1} − x_{i+1}).
-                let area = imesh_quality::quad::area(&q);
+                let area = 0.5
+                    * ((p[2].x - p[0].x) * (p[3].y - p[1].y)
+                        - (p[3].x - p[1].x) * (p[2].y - p[0].y));
                 let r = area / self.average_area;
                 let (rel, drel) = if r < 1.0 {
                     (r * r, 2.0 * r)

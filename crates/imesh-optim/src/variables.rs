@@ -166,6 +166,26 @@ impl Variables {
             list.sort_by_key(|&(v, _)| v);
             list.dedup_by_key(|&mut (v, _)| v);
         }
+        // Control points that move exactly the same quad vertices are one degree of freedom
+        // solved several times: at level 1 a quad patch's four inner points all move only its
+        // centre, and an edge's two inner points the same midpoint and centres. The first of
+        // each such set is kept.
+        let mut seen = std::collections::HashMap::new();
+        let keep: Vec<bool> = influence
+            .iter()
+            .map(|list| {
+                let key: Vec<u32> = list.iter().map(|&(v, _)| v).collect();
+                seen.insert(key, ()).is_none()
+            })
+            .collect();
+        fn pick<T>(list: Vec<T>, keep: &[bool]) -> Vec<T> {
+            list.into_iter()
+                .zip(keep)
+                .filter(|&(_, &k)| k)
+                .map(|(x, _)| x)
+                .collect()
+        }
+        let (ids, influence, ring) = (pick(ids, &keep), pick(influence, &keep), pick(ring, &keep));
         Self::finish(ids, influence, ring, mesh)
     }
 
