@@ -32,7 +32,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
   bench optim      the quad optimisers (none, laplacian, vertex, local; global on the small
                    fixtures) through the whole pipeline: worst / mean quality and seconds;
                    writes target/bench/optim.json
-    --global-iterations N   Powell iterations of the global mode (default 3)
+    --global-iterations N   Powell iterations of the global mode (default 10)
 
   fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
                    vtkMeshQuality, installed from PyPI into target/venv-vtk";
@@ -86,7 +86,7 @@ fn run(args: &[String]) -> Result<(), String> {
         }
         ["bench", "optim", rest @ ..] => {
             let iterations = match rest {
-                [] => 3,
+                [] => 10,
                 ["--global-iterations", n] => {
                     n.parse().ok().filter(|&r: &u64| r > 0).ok_or_else(|| {
                         format!("--global-iterations takes a positive integer, not '{n}'")

@@ -189,7 +189,7 @@ pub(crate) fn minimise(
         }),
     };
     let powell = Powell::new(0.2 * setup.average_area.sqrt())
-        .with_tolerance(setup.tolerance)
+        .with_tolerance(1e-5)
         .with_line_search(1e-3, 16);
     let result = Executor::new(energy, powell)
         .configure(|s| {
