@@ -1,6 +1,7 @@
-//! Interop: meshio (the Python mesh I/O library most solvers' users have) reads what we write.
-//! `.ci/run` installs meshio into `target/venv-io` and points `IMESH_PYTHON` at its Python; run
-//! locally the same way, or the test says how and passes without checking.
+//! Interop: meshio (the Python mesh I/O library most solvers' users have) reads what we write, and
+//! Gmsh itself opens our `.msh` files with the same physical groups. `.ci/run` installs meshio and
+//! gmsh into `target/venv-io` and points `IMESH_PYTHON` at its Python; run locally the same way,
+//! or the tests say how and pass without checking.
 
 use std::path::Path;
 use std::process::Command;
@@ -89,5 +90,88 @@ fn meshio_reads_our_msh_and_vtu() {
         } else {
             assert_eq!(read["labels"], serde_json::json!([0, 1, 2, 3, 4]));
         }
+    }
+}
+
+#[test]
+fn gmsh_opens_our_msh_with_the_same_physical_groups() {
+    let Ok(python) = std::env::var("IMESH_PYTHON") else {
+        eprintln!("IMESH_PYTHON is not set: skipping the Gmsh check (.ci/run sets it up: python3 -m venv target/venv-io && target/venv-io/bin/pip install gmsh)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for fixture in ["stardist-mask2d_labels.png", "skimage-coins.png"] {
+        let image = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/images")
+            .join(fixture);
+        let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
+            .args([
+                "mesh",
+                image.to_str().unwrap(),
+                "-o",
+                "m.msh",
+                "--report",
+                "r.json",
+                "-q",
+            ])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
+                .unwrap();
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/gmsh_read.py");
+        let read = Command::new(&python)
+            .arg(script)
+            .arg(dir.path().join("m.msh"))
+            .output()
+            .expect("the Python of IMESH_PYTHON runs");
+        assert!(
+            read.status.success(),
+            "Gmsh could not open the mesh of {fixture}: {}",
+            String::from_utf8_lossy(&read.stderr)
+        );
+        let seen: serde_json::Value = serde_json::from_slice(&read.stdout).unwrap();
+        assert_eq!(seen["nodes"], report["counts"]["vertices"], "{fixture}");
+        assert_eq!(
+            seen["elements"]["Quadrilateral 4"], report["counts"]["quads"],
+            "{fixture}"
+        );
+        assert!(
+            seen["elements"]["Triangle 3"].is_null(),
+            "{fixture}: no triangles"
+        );
+        let groups = seen["groups"].as_array().unwrap();
+        let surfaces: Vec<&serde_json::Value> = groups.iter().filter(|g| g["dim"] == 2).collect();
+        // One named physical surface per label, together holding every quad once.
+        assert_eq!(
+            surfaces.len() as u64,
+            report["counts"]["labels"].as_u64().unwrap(),
+            "{fixture}"
+        );
+        assert!(surfaces
+            .iter()
+            .all(|g| !g["name"].as_str().unwrap().is_empty()));
+        let held: u64 = surfaces
+            .iter()
+            .map(|g| g["elements"].as_u64().unwrap())
+            .sum();
+        assert_eq!(
+            held,
+            report["counts"]["quads"].as_u64().unwrap(),
+            "{fixture}"
+        );
+        // Named boundary curves, the domain border among them, with line elements.
+        let curves: Vec<&serde_json::Value> = groups.iter().filter(|g| g["dim"] == 1).collect();
+        assert!(!curves.is_empty(), "{fixture}");
+        assert!(curves
+            .iter()
+            .any(|g| g["name"].as_str().unwrap().starts_with("border_")));
+        assert!(curves.iter().all(|g| g["elements"].as_u64().unwrap() > 0));
     }
 }
