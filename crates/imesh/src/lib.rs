@@ -19,6 +19,7 @@
 
 use std::path::Path;
 use std::str::FromStr;
+use std::sync::Arc;
 use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
@@ -384,16 +385,95 @@ pub struct PipelineResult {
     pub report: Report,
 }
 
+/// A stage of the pipeline, as the progress callback hears of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Loading and classifying the image.
+    Classify,
+    /// Imesh sampling, partition and c-edges.
+    Sample,
+    /// Quality refinement of the triangle mesh.
+    Refine,
+    /// Curve simplification and fitting.
+    Curves,
+    /// DT', pairing, templates and boundary adaptation.
+    Quads,
+    /// Optimisation of the quads.
+    Optimise,
+    /// Invariant checks and quality measurement.
+    Check,
+}
+
+impl Stage {
+    /// What the stage does, for a progress line.
+    pub fn description(self) -> &'static str {
+        match self {
+            Stage::Classify => "classifying the image",
+            Stage::Sample => "sampling (Imesh)",
+            Stage::Refine => "refining the triangles",
+            Stage::Curves => "simplifying and fitting the boundaries",
+            Stage::Quads => "building the quads",
+            Stage::Optimise => "optimising the quads",
+            Stage::Check => "checking the mesh",
+        }
+    }
+}
+
+/// The progress callback: told each stage as it starts.
+type Progress = Arc<dyn Fn(Stage) + Send + Sync>;
+
 /// Image → mesh, with typed options and timed stages.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Pipeline {
     options: MeshOptions,
+    progress: Option<Progress>,
+}
+
+impl std::fmt::Debug for Pipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pipeline")
+            .field("options", &self.options)
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
 }
 
 impl Pipeline {
     /// A pipeline with these options.
     pub fn new(options: MeshOptions) -> Self {
-        Self { options }
+        Self {
+            options,
+            progress: None,
+        }
+    }
+
+    /// Calls `progress` as each stage starts (e.g. to drive a progress bar).
+    ///
+    /// ```
+    /// use std::sync::{Arc, Mutex};
+    /// use imesh::{MeshOptions, Pipeline, Stage};
+    /// let image = image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(16, 16, |x, _| {
+    ///     image::Luma([if x < 8 { 0 } else { 255 }])
+    /// }));
+    /// let heard = Arc::new(Mutex::new(Vec::new()));
+    /// let log = Arc::clone(&heard);
+    /// Pipeline::new(MeshOptions::default())
+    ///     .with_progress(move |stage| log.lock().unwrap().push(stage))
+    ///     .run_image(&image)?;
+    /// assert_eq!(heard.lock().unwrap().first(), Some(&Stage::Classify));
+    /// assert_eq!(heard.lock().unwrap().last(), Some(&Stage::Check));
+    /// # Ok::<(), imesh::PipelineError>(())
+    /// ```
+    #[must_use]
+    pub fn with_progress(mut self, progress: impl Fn(Stage) + Send + Sync + 'static) -> Self {
+        self.progress = Some(Arc::new(progress));
+        self
+    }
+
+    fn stage(&self, stage: Stage) {
+        if let Some(progress) = &self.progress {
+            progress(stage);
+        }
     }
 
     /// Loads `path` (refusing images above `max_pixels`) and meshes it.
@@ -402,8 +482,9 @@ impl Pipeline {
     /// [`PipelineError`], each saying what to change.
     pub fn run_path(&self, path: &Path) -> Result<PipelineResult, PipelineError> {
         let start = Instant::now();
+        self.stage(Stage::Classify);
         let image = load_image(path, self.options.max_pixels)?;
-        let mut result = self.run_image(&image)?;
+        let mut result = self.classify_and_run(&image)?;
         let load = start.elapsed().as_secs_f64() - result.report.seconds.total;
         result.report.seconds.classify += load;
         result.report.seconds.total += load;
@@ -415,6 +496,14 @@ impl Pipeline {
     /// # Errors
     /// [`PipelineError`], each saying what to change.
     pub fn run_image(&self, image: &image::DynamicImage) -> Result<PipelineResult, PipelineError> {
+        self.stage(Stage::Classify);
+        self.classify_and_run(image)
+    }
+
+    fn classify_and_run(
+        &self,
+        image: &image::DynamicImage,
+    ) -> Result<PipelineResult, PipelineError> {
         let o = &self.options;
         self.check_options()?;
         let start = Instant::now();
@@ -436,6 +525,7 @@ impl Pipeline {
         let o = &self.options;
         self.check_options()?;
         let start = Instant::now();
+        self.stage(Stage::Sample);
         let mut segmented = SegmentedMesh::from_grid(
             grid,
             &SampleOptions {
@@ -463,6 +553,7 @@ impl Pipeline {
             Elements::Quad => self.quads(&segmented, &mut counts, &mut seconds, &mut optimised)?,
         };
         let check = Instant::now();
+        self.stage(Stage::Check);
         let checked = validate(
             &MeshView {
                 vertices: &vertices,
@@ -542,6 +633,7 @@ impl Pipeline {
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
+        self.stage(Stage::Refine);
         let refined = segmented.refine(&RefineOptions {
             min_angle_deg: o.min_angle.unwrap_or(imesh_segment::DEFAULT_MIN_ANGLE),
             max_steiner: o.max_steiner.unwrap_or(usize::MAX),
@@ -569,6 +661,7 @@ impl Pipeline {
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
+        self.stage(Stage::Curves);
         let edges = segmented
             .c_edges
             .iter()
@@ -592,6 +685,7 @@ impl Pipeline {
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
         seconds.curves = start.elapsed().as_secs_f64();
+        self.stage(Stage::Quads);
         let mut r = remesh(
             &simplified.graph,
             &curves,
@@ -622,6 +716,7 @@ impl Pipeline {
                 r.adaptation.invalid_left
             )));
         }
+        self.stage(Stage::Optimise);
         let optimisation = optimise(
             &mut r,
             &OptimOptions {

@@ -1,5 +1,6 @@
 //! The `imesh` command line: parses arguments, runs the [`imesh::Pipeline`], writes the outputs.
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -13,6 +14,7 @@ use imesh_io::{
     write_atomic, write_inp, write_msh, write_png, write_svg, write_vtk, write_vtu, Frame,
     SvgOptions,
 };
+use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 #[derive(Parser)]
@@ -298,9 +300,23 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     let frame = Frame {
         pixel_size: options.pixel_size,
     };
-    let PipelineResult { mesh, report } = Pipeline::new(options)
-        .run_path(&args.image)
-        .map_err(|e| e.to_string())?;
+    // A spinner naming the running stage, on stderr, only for a person watching.
+    let bar = if args.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new_spinner();
+        if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+            bar.set_style(style);
+        }
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        bar
+    };
+    let shown = bar.clone();
+    let result = Pipeline::new(options)
+        .with_progress(move |stage| shown.set_message(stage.description()))
+        .run_path(&args.image);
+    bar.finish_and_clear();
+    let PipelineResult { mesh, report } = result.map_err(|e| e.to_string())?;
     write_mesh(&output, &format, &mesh, &frame)?;
     if let Some(svg) = &args.svg {
         write_svg(svg, &mesh, &SvgOptions::default()).map_err(|e| e.to_string())?;

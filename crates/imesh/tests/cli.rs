@@ -74,6 +74,8 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // No progress bar when stderr is not a terminal (here a pipe): stderr stays clean.
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
     // The default output: the image's name with .msh, in the working directory.
     let msh = std::fs::read_to_string(dir.path().join("pyvista-channels_z050_labels.msh")).unwrap();
     let report: serde_json::Value =
