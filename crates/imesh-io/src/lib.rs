@@ -27,6 +27,7 @@
 //! ```
 
 mod boundary;
+mod histogram;
 mod inp;
 mod msh;
 mod png;
@@ -40,6 +41,7 @@ use std::path::{Path, PathBuf};
 use imesh_quality::Element;
 
 pub use boundary::{boundaries, sanitize, Boundary, OUTSIDE};
+pub use histogram::{histogram_picture, write_histogram, HistogramPanel};
 pub use inp::{inp_string, write_inp};
 pub use msh::{msh_string, write_msh};
 pub use png::{rasterise, write_png};

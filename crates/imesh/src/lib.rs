@@ -29,7 +29,8 @@ use imesh_io::SegmentedMeshData;
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 use imesh_quality::{
-    validate, Domain, Element, MeshView, QuadQuality, Statistics, TriangleQuality,
+    average_quad_area, quad_corners, quad_values, validate, Domain, Element, Histogram, MeshView,
+    QuadQuality, Statistics, TriangleQuality,
 };
 use imesh_segment::{SampleOptions, SegmentedMesh};
 use serde::{Deserialize, Serialize};
@@ -344,6 +345,33 @@ pub struct Optimisation {
     pub sweeps: usize,
 }
 
+/// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
+/// paper's Figure 7 shows them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct QualityHistograms {
+    /// Shape-and-size before optimisation.
+    pub shape_and_size_before: Histogram,
+    /// Shape-and-size after.
+    pub shape_and_size_after: Histogram,
+    /// Scaled Jacobian before optimisation.
+    pub scaled_jacobian_before: Histogram,
+    /// Scaled Jacobian after.
+    pub scaled_jacobian_after: Histogram,
+}
+
+/// Shape-and-size and scaled Jacobian histograms of quads (20 bins over [0, 1]).
+fn quad_histograms(vertices: &[imesh_geom::Point], quads: &[[u32; 4]]) -> (Histogram, Histogram) {
+    let points: Vec<[f64; 2]> = vertices.iter().map(|p| [p.x, p.y]).collect();
+    let corners = quad_corners(&points, quads);
+    let values = quad_values(&corners, average_quad_area(&corners));
+    let column =
+        |f: fn(&imesh_quality::QuadValues) -> f64| -> Vec<f64> { values.iter().map(f).collect() };
+    (
+        Histogram::of(&column(|v| v.shape_and_size), 0.0, 1.0, 20),
+        Histogram::of(&column(|v| v.scaled_jacobian), 0.0, 1.0, 20),
+    )
+}
+
 /// The invariant checks' outcome.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Validation {
@@ -372,6 +400,9 @@ pub struct Report {
     /// What the optimiser did (quads only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimisation: Option<Optimisation>,
+    /// Quality histograms before and after optimisation (quads only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub histograms: Option<QualityHistograms>,
     /// Invariant checks.
     pub validation: Validation,
 }
@@ -614,8 +645,9 @@ impl Pipeline {
             quality,
             quality_before_optimisation: optimised
                 .as_ref()
-                .map(|(_, before)| MeshQuality::Quads(before.clone())),
-            optimisation: optimised.map(|(o, _)| o),
+                .map(|(_, before, _)| MeshQuality::Quads(before.clone())),
+            histograms: optimised.as_ref().map(|(_, _, h)| h.clone()),
+            optimisation: optimised.map(|(o, _, _)| o),
             validation: Validation {
                 valid: true,
                 area_ratio: checked.area / (f64::from(w) * f64::from(h)),
@@ -657,7 +689,7 @@ impl Pipeline {
         segmented: &SegmentedMesh,
         counts: &mut Counts,
         seconds: &mut StageSeconds,
-        optimised: &mut Option<(Optimisation, QuadQuality)>,
+        optimised: &mut Option<(Optimisation, QuadQuality, QualityHistograms)>,
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
@@ -717,6 +749,7 @@ impl Pipeline {
             )));
         }
         self.stage(Stage::Optimise);
+        let (sas_before, sj_before) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         let optimisation = optimise(
             &mut r,
             &OptimOptions {
@@ -730,6 +763,7 @@ impl Pipeline {
             },
         )?;
         seconds.optimise = optimisation.seconds;
+        let (sas_after, sj_after) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         *optimised = Some((
             Optimisation {
                 method: o.optimizer,
@@ -741,6 +775,12 @@ impl Pipeline {
                 sweeps: optimisation.sweeps,
             },
             optimisation.before,
+            QualityHistograms {
+                shape_and_size_before: sas_before,
+                shape_and_size_after: sas_after,
+                scaled_jacobian_before: sj_before,
+                scaled_jacobian_after: sj_after,
+            },
         ));
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
         let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();

@@ -11,8 +11,8 @@ use imesh::{
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
-    write_atomic, write_inp, write_msh, write_png, write_svg, write_vtk, write_vtu, Frame,
-    SvgOptions,
+    write_atomic, write_histogram, write_inp, write_msh, write_png, write_svg, write_vtk,
+    write_vtu, Frame, HistogramPanel, SvgOptions,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -62,6 +62,9 @@ struct MeshArgs {
     /// Also draw the mesh as PNG.
     #[arg(long)]
     png: Option<PathBuf>,
+    /// Also draw the quality histograms before and after optimisation (PNG; quads only).
+    #[arg(long)]
+    histogram: Option<PathBuf>,
     /// Also write the JSON report (counts, per-stage seconds, quality, label agreement).
     #[arg(long)]
     report: Option<PathBuf>,
@@ -297,6 +300,12 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         }
     };
     let format = format_of(&output)?;
+    if args.histogram.is_some() && options.elements == Elements::Tri {
+        return Err(
+            "--histogram shows the quads' quality before and after optimisation: drop --elements tri"
+                .into(),
+        );
+    }
     let frame = Frame {
         pixel_size: options.pixel_size,
     };
@@ -323,6 +332,25 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     }
     if let Some(png) = &args.png {
         write_png(png, &mesh).map_err(|e| e.to_string())?;
+    }
+    if let Some(path) = &args.histogram {
+        let h = report
+            .histograms
+            .as_ref()
+            .ok_or("the quad mesh has no histograms")?;
+        let panels = [
+            HistogramPanel {
+                title: "SHAPE AND SIZE",
+                before: &h.shape_and_size_before,
+                after: &h.shape_and_size_after,
+            },
+            HistogramPanel {
+                title: "SCALED JACOBIAN",
+                before: &h.scaled_jacobian_before,
+                after: &h.scaled_jacobian_after,
+            },
+        ];
+        write_histogram(path, &panels).map_err(|e| e.to_string())?;
     }
     if let Some(path) = &args.report {
         write_report(path, &report)?;

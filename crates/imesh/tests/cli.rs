@@ -75,7 +75,11 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
         String::from_utf8_lossy(&out.stderr)
     );
     // No progress bar when stderr is not a terminal (here a pipe): stderr stays clean.
-    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // The default output: the image's name with .msh, in the working directory.
     let msh = std::fs::read_to_string(dir.path().join("pyvista-channels_z050_labels.msh")).unwrap();
     let report: serde_json::Value =
@@ -266,7 +270,7 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
     let image = image.to_str().unwrap();
-    let cases: [(&[&str], &str); 10] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["mesh", "missing.png"], "missing.png"),
         (&["mesh", image, "-o", "out.obj"], ".msh"),
         (&["mesh", image, "--te", "2"], "t_e"),
@@ -279,6 +283,10 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (
             &["mesh", image, "--metric", "jacobian"],
             "shape-and-size or shape",
+        ),
+        (
+            &["mesh", image, "--elements", "tri", "--histogram", "h.png"],
+            "drop --elements tri",
         ),
     ];
     for (args, hint) in cases {
@@ -400,4 +408,52 @@ fn batch_meshes_a_folder_and_reports_failures_without_stopping() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.path().join("out2/matplotlib-s1045_mri.msh").exists());
+}
+
+#[test]
+fn the_histogram_shows_quality_before_and_after_optimisation() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("stardist-mask2d_labels.png");
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "-o",
+            "m.vtu",
+            "--histogram",
+            "h.png",
+            "--report",
+            "r.json",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let picture = image::open(dir.path().join("h.png")).unwrap().to_rgb8();
+    assert_eq!(picture.dimensions(), (520, 520), "two panels");
+    // Grey (before) and blue (after) bars are both there.
+    let has = |c: [u8; 3]| picture.pixels().filter(|p| p.0 == c).count() > 200;
+    assert!(has([150, 150, 150]) && has([40, 90, 200]));
+    // The report carries the same histograms: every quad counted once, before and after.
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let quads = report["counts"]["quads"].as_u64().unwrap();
+    for key in [
+        "shape_and_size_before",
+        "shape_and_size_after",
+        "scaled_jacobian_before",
+        "scaled_jacobian_after",
+    ] {
+        let counts = report["histograms"][key]["counts"].as_array().unwrap();
+        assert_eq!(counts.len(), 20, "{key}");
+        assert_eq!(
+            counts.iter().map(|c| c.as_u64().unwrap()).sum::<u64>(),
+            quads,
+            "{key}"
+        );
+    }
 }
