@@ -11,9 +11,10 @@ use imesh::{
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
-    write_atomic, write_histogram, write_inp, write_msh, write_png, write_svg, write_vtk,
-    write_vtu, Frame, HistogramPanel, SvgOptions,
+    read_mesh, write_atomic, write_histogram, write_inp, write_msh, write_png, write_svg,
+    write_vtk, write_vtu, Frame, HistogramPanel, SvgOptions,
 };
+use imesh_quality::{Element, QuadQuality, TriangleQuality};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
@@ -41,6 +42,10 @@ enum Command {
         after_help = "Example:\n  imesh classify fixtures/images/skimage-coffee.png --classify kmeans:4 -o coffee-labels.png"
     )]
     Classify(ClassifyArgs),
+    /// Measure a mesh file's quality with Verdict's metrics (as VTK computes them): Gmsh MSH 4.1 or
+    /// legacy VTK, ASCII.
+    #[command(after_help = "Example:\n  imesh quality coins.msh --json")]
+    Quality(QualityArgs),
     /// Mesh every image of a folder, in parallel; one failure does not stop the others.
     #[command(after_help = "Example:\n  imesh batch fixtures/images -o meshes --format vtu")]
     Batch(BatchArgs),
@@ -136,6 +141,15 @@ struct MeshFlags {
 }
 
 #[derive(Args)]
+struct QualityArgs {
+    /// The mesh (.msh or .vtk).
+    mesh: PathBuf,
+    /// Print the statistics as JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
 struct ClassifyArgs {
     /// The image.
     image: PathBuf,
@@ -169,6 +183,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Mesh(args) => mesh(&args),
         Command::Classify(args) => classify_command(&args),
+        Command::Quality(args) => quality_command(&args),
         Command::Batch(args) => batch(&args),
     };
     match result {
@@ -285,6 +300,69 @@ fn write_mesh(
 fn write_report(path: &Path, report: &imesh::Report) -> Result<(), String> {
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
     write_atomic(path, json.as_bytes()).map_err(|e| e.to_string())
+}
+
+fn quality_command(args: &QualityArgs) -> Result<(), String> {
+    let mesh = read_mesh(&args.mesh).map_err(|e| e.to_string())?;
+    let (mut quads, mut triangles) = (Vec::new(), Vec::new());
+    for e in &mesh.elements {
+        match *e {
+            Element::Quad(q) => quads.push(q),
+            Element::Triangle(t) => triangles.push(t),
+        }
+    }
+    if quads.is_empty() && triangles.is_empty() {
+        return Err(format!(
+            "{} holds no triangles or quads: nothing to measure",
+            args.mesh.display()
+        ));
+    }
+    let quad_quality = (!quads.is_empty()).then(|| QuadQuality::of(&mesh.vertices, &quads));
+    let triangle_quality =
+        (!triangles.is_empty()).then(|| TriangleQuality::of(&mesh.vertices, &triangles));
+    if args.json {
+        let json = serde_json::json!({
+            "vertices": mesh.vertices.len(),
+            "quads": quads.len(),
+            "triangles": triangles.len(),
+            "quad_quality": quad_quality,
+            "triangle_quality": triangle_quality,
+        });
+        println!("{json:#}");
+        return Ok(());
+    }
+    println!(
+        "{}: {} vertices, {} quads, {} triangles",
+        args.mesh.display(),
+        mesh.vertices.len(),
+        quads.len(),
+        triangles.len()
+    );
+    let row = |name: &str, s: &imesh_quality::Statistics| {
+        println!(
+            "  {name:<16} min {:>9.4}  mean {:>9.4}  max {:>9.4}  variance {:>9.2e}  below {} {:>6}",
+            s.min, s.mean, s.max, s.variance, s.threshold, s.below
+        );
+    };
+    if let Some(q) = &quad_quality {
+        println!(
+            "quads (shape-and-size against the mean quad area {:.4}):",
+            q.average_area
+        );
+        row("shape-and-size", &q.shape_and_size);
+        row("shape", &q.shape);
+        row("scaled Jacobian", &q.scaled_jacobian);
+        row("min angle (°)", &q.min_angle_deg);
+        row("max angle (°)", &q.max_angle_deg);
+    }
+    if let Some(t) = &triangle_quality {
+        println!("triangles:");
+        row("shape", &t.shape);
+        row("scaled Jacobian", &t.scaled_jacobian);
+        row("min angle (°)", &t.min_angle_deg);
+        row("max angle (°)", &t.max_angle_deg);
+    }
+    Ok(())
 }
 
 fn mesh(args: &MeshArgs) -> Result<(), String> {

@@ -457,3 +457,83 @@ fn the_histogram_shows_quality_before_and_after_optimisation() {
         );
     }
 }
+
+#[test]
+fn quality_measures_a_written_mesh_as_the_report_did() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coins.png");
+    for (name, elements) in [("m.msh", "quad"), ("m.vtk", "tri")] {
+        let out = imesh(
+            &[
+                "mesh",
+                image.to_str().unwrap(),
+                "-o",
+                name,
+                "--elements",
+                elements,
+                "--report",
+                "r.json",
+                "-q",
+            ],
+            dir.path(),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
+                .unwrap();
+        let out = imesh(&["quality", name, "--json"], dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(measured["vertices"], report["counts"]["vertices"], "{name}");
+        assert_eq!(measured["quads"], report["counts"]["quads"], "{name}");
+        assert_eq!(
+            measured["triangles"], report["counts"]["triangles"],
+            "{name}"
+        );
+        let block = if elements == "quad" {
+            "quad_quality"
+        } else {
+            "triangle_quality"
+        };
+        // The written frame is y-up: the same shapes, so the same statistics (to rounding).
+        for metric in ["shape", "scaled_jacobian", "min_angle_deg"] {
+            for s in ["min", "mean"] {
+                let (a, b) = (
+                    measured[block][metric][s].as_f64().unwrap(),
+                    report["quality"][metric][s].as_f64().unwrap(),
+                );
+                assert!(
+                    (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+                    "{name} {metric} {s}: {a} vs {b}"
+                );
+            }
+        }
+        let table = imesh(&["quality", name], dir.path());
+        assert!(String::from_utf8_lossy(&table.stdout).contains("scaled Jacobian"));
+    }
+    std::fs::write(
+        dir.path().join("bad.msh"),
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n",
+    )
+    .unwrap();
+    for (file, hint) in [
+        ("bad.msh", "not 4.1"),
+        ("missing.vtk", "cannot read"),
+        ("m.json", ".msh"),
+    ] {
+        let out = imesh(&["quality", file], dir.path());
+        assert_eq!(out.status.code(), Some(2), "{file}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(hint),
+            "{file}"
+        );
+    }
+}
