@@ -384,14 +384,22 @@ pub struct Validation {
 /// The JSON report of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
+    /// The program's version.
+    pub imesh_version: &'static str,
+    /// The image meshed.
+    pub input: Input,
     /// The options used.
     pub options: MeshOptions,
     /// Counts.
     pub counts: Counts,
-    /// Per-stage seconds.
+    /// Per-stage seconds (`"timings_s"` in the JSON, as DESIGN.md §6 names it).
+    #[serde(rename = "timings_s")]
     pub seconds: StageSeconds,
-    /// Share of pixels whose centre lies in an element of the pixel's label.
+    /// Share of pixels whose centre lies in an element of the pixel's label (also under
+    /// `fidelity`).
     pub label_agreement: f64,
+    /// How closely the mesh follows the image's regions.
+    pub fidelity: Fidelity,
     /// Quality statistics.
     pub quality: MeshQuality,
     /// Quality statistics of the quads before optimisation (quads only).
@@ -405,6 +413,36 @@ pub struct Report {
     pub histograms: Option<QualityHistograms>,
     /// Invariant checks.
     pub validation: Validation,
+}
+
+/// The image a report is about.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Input {
+    /// Its path, when it was read from a file.
+    pub path: Option<String>,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+/// How closely the mesh follows the image's regions.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Fidelity {
+    /// Share of pixels whose centre lies in an element of the pixel's label.
+    pub label_agreement: f64,
+    /// Quads: the largest distance, either way, between a fitted boundary curve and the Imesh
+    /// boundary chain it replaces (pixels); the triangle mesh's boundaries are the chains
+    /// themselves (0).
+    pub boundary_hausdorff_px: f64,
+}
+
+/// What the quad path adds to the report.
+struct QuadExtras {
+    optimisation: Optimisation,
+    before: QuadQuality,
+    histograms: QualityHistograms,
+    hausdorff: f64,
 }
 
 /// The outcome of a run: the mesh, ready for the writers, and its report.
@@ -519,6 +557,7 @@ impl Pipeline {
         let load = start.elapsed().as_secs_f64() - result.report.seconds.total;
         result.report.seconds.classify += load;
         result.report.seconds.total += load;
+        result.report.input.path = Some(path.display().to_string());
         Ok(result)
     }
 
@@ -641,13 +680,23 @@ impl Pipeline {
             options: o.clone(),
             counts,
             seconds,
+            imesh_version: env!("CARGO_PKG_VERSION"),
+            input: Input {
+                path: None,
+                width: w,
+                height: h,
+            },
             label_agreement,
+            fidelity: Fidelity {
+                label_agreement,
+                boundary_hausdorff_px: optimised.as_ref().map_or(0.0, |x| x.hausdorff),
+            },
             quality,
             quality_before_optimisation: optimised
                 .as_ref()
-                .map(|(_, before, _)| MeshQuality::Quads(before.clone())),
-            histograms: optimised.as_ref().map(|(_, _, h)| h.clone()),
-            optimisation: optimised.map(|(o, _, _)| o),
+                .map(|x| MeshQuality::Quads(x.before.clone())),
+            histograms: optimised.as_ref().map(|x| x.histograms.clone()),
+            optimisation: optimised.map(|x| x.optimisation),
             validation: Validation {
                 valid: true,
                 area_ratio: checked.area / (f64::from(w) * f64::from(h)),
@@ -689,7 +738,7 @@ impl Pipeline {
         segmented: &SegmentedMesh,
         counts: &mut Counts,
         seconds: &mut StageSeconds,
-        optimised: &mut Option<(Optimisation, QuadQuality, QualityHistograms)>,
+        optimised: &mut Option<QuadExtras>,
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
@@ -764,8 +813,9 @@ impl Pipeline {
         )?;
         seconds.optimise = optimisation.seconds;
         let (sas_after, sj_after) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
-        *optimised = Some((
-            Optimisation {
+        *optimised = Some(QuadExtras {
+            hausdorff: fits.max_error.max(fits.max_curve_deviation),
+            optimisation: Optimisation {
                 method: o.optimizer,
                 metric: o.metric,
                 variables: optimisation.variables,
@@ -774,14 +824,14 @@ impl Pipeline {
                 energy_after: optimisation.energy_after,
                 sweeps: optimisation.sweeps,
             },
-            optimisation.before,
-            QualityHistograms {
+            before: optimisation.before,
+            histograms: QualityHistograms {
                 shape_and_size_before: sas_before,
                 shape_and_size_after: sas_after,
                 scaled_jacobian_before: sj_before,
                 scaled_jacobian_after: sj_after,
             },
-        ));
+        });
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
         let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
         Ok((vertices, elements, r.mesh.labels))

@@ -101,6 +101,25 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
     assert!(report["label_agreement"].as_f64().unwrap() > 0.97);
+    // DESIGN.md §6's stable keys.
+    assert_eq!(
+        report["fidelity"]["label_agreement"],
+        report["label_agreement"]
+    );
+    let hausdorff = report["fidelity"]["boundary_hausdorff_px"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        hausdorff > 0.0 && hausdorff <= 2.0 + 1e-9,
+        "within the 2 px tolerance: {hausdorff}"
+    );
+    assert!(report["timings_s"]["total"].as_f64().unwrap() > 0.0);
+    assert_eq!(report["imesh_version"], env!("CARGO_PKG_VERSION"));
+    assert!(report["input"]["path"]
+        .as_str()
+        .unwrap()
+        .ends_with("pyvista-channels_z050_labels.png"));
+    assert_eq!(report["input"]["width"], 250);
     // The default is an all-quad mesh, and the report says how it was made.
     assert_eq!(report["counts"]["triangles"], 0);
     assert_eq!(report["counts"]["quads"], report["counts"]["elements"]);
