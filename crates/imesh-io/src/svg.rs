@@ -16,6 +16,8 @@ pub struct SvgOptions {
     pub fill_opacity: f64,
     /// Edge width in pixels.
     pub stroke_width: f64,
+    /// Line segments drawn over the elements (boundaries of a stage), in image coordinates.
+    pub overlay: Vec<[[f64; 2]; 2]>,
 }
 
 impl Default for SvgOptions {
@@ -24,6 +26,7 @@ impl Default for SvgOptions {
             background: None,
             fill_opacity: 1.0,
             stroke_width: 0.1,
+            overlay: Vec::new(),
         }
     }
 }
@@ -71,7 +74,19 @@ pub fn svg_string(mesh: &SegmentedMeshData, options: &SvgOptions) -> String {
             points.join(" ")
         );
     }
-    let _ = writeln!(s, "</g>\n</svg>");
+    let _ = writeln!(s, "</g>");
+    if !options.overlay.is_empty() {
+        let _ = write!(
+            s,
+            "<path fill=\"none\" stroke=\"#e02020\" stroke-width=\"{}\" stroke-linecap=\"round\" d=\"",
+            3.0 * options.stroke_width
+        );
+        for [a, b] in &options.overlay {
+            let _ = write!(s, "M{:.4} {:.4}L{:.4} {:.4}", a[0], a[1], b[0], b[1]);
+        }
+        let _ = writeln!(s, "\"/>");
+    }
+    let _ = writeln!(s, "</svg>");
     s
 }
 

@@ -452,6 +452,56 @@ pub struct PipelineResult {
     pub mesh: SegmentedMeshData,
     /// What happened.
     pub report: Report,
+    /// Pictures of every stage, in order (only with [`Pipeline::with_stages`]).
+    pub stages: Vec<StagePicture>,
+    /// The label image, one colour per label (only with [`Pipeline::with_stages`]).
+    pub label_picture: Option<image::RgbImage>,
+}
+
+/// A picture of one stage (`--stages`), as the paper's Figures 1–2 show them: elements coloured
+/// by label (none for a stage that is only boundaries) and segments drawn over them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StagePicture {
+    /// A file-name stem that sorts in pipeline order, e.g. `"05-dt"`.
+    pub name: String,
+    /// Vertices in image coordinates.
+    pub vertices: Vec<[f64; 2]>,
+    /// Elements.
+    pub elements: Vec<Element>,
+    /// A label per element.
+    pub labels: Vec<u32>,
+    /// Segments drawn over the elements.
+    pub lines: Vec<[[f64; 2]; 2]>,
+}
+
+/// Collects stage pictures when asked to; building one costs nothing otherwise.
+struct Pictures {
+    on: bool,
+    list: Vec<StagePicture>,
+}
+
+type Drawing = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>, Vec<[[f64; 2]; 2]>);
+
+impl Pictures {
+    fn add(&mut self, name: &str, draw: impl FnOnce() -> Drawing) {
+        if self.on {
+            let (vertices, elements, labels, lines) = draw();
+            self.list.push(StagePicture {
+                name: format!("{:02}-{name}", self.list.len() + 1),
+                vertices,
+                elements,
+                labels,
+                lines,
+            });
+        }
+    }
+}
+
+/// The segments of a graph's edges.
+fn segments(points: &[[f64; 2]], edges: impl Iterator<Item = [u32; 2]>) -> Vec<[[f64; 2]; 2]> {
+    edges
+        .map(|[a, b]| [points[a as usize], points[b as usize]])
+        .collect()
 }
 
 /// A stage of the pipeline, as the progress callback hears of it.
@@ -496,6 +546,7 @@ type Progress = Arc<dyn Fn(Stage) + Send + Sync>;
 pub struct Pipeline {
     options: MeshOptions,
     progress: Option<Progress>,
+    stages: bool,
 }
 
 impl std::fmt::Debug for Pipeline {
@@ -503,6 +554,7 @@ impl std::fmt::Debug for Pipeline {
         f.debug_struct("Pipeline")
             .field("options", &self.options)
             .field("progress", &self.progress.is_some())
+            .field("stages", &self.stages)
             .finish()
     }
 }
@@ -513,7 +565,15 @@ impl Pipeline {
         Self {
             options,
             progress: None,
+            stages: false,
         }
+    }
+
+    /// Also returns a picture of every stage ([`PipelineResult::stages`]).
+    #[must_use]
+    pub fn with_stages(mut self) -> Self {
+        self.stages = true;
+        self
     }
 
     /// Calls `progress` as each stage starts (e.g. to drive a progress bar).
@@ -617,11 +677,58 @@ impl Pipeline {
             c_edges: segmented.c_edges.len(),
             ..Default::default()
         };
+        let mut pictures = Pictures {
+            on: self.stages,
+            list: Vec::new(),
+        };
+        let label_picture = self.stages.then(|| {
+            image::RgbImage::from_fn(w, h, |x, y| {
+                let l = grid.label(x, y) as usize;
+                image::Rgb(grid.regions().get(l).map_or([128; 3], |r| r.colour))
+            })
+        });
+        let c_edge_lines = |segmented: &SegmentedMesh| {
+            let points: Vec<[f64; 2]> = segmented
+                .triangulation
+                .points()
+                .iter()
+                .map(|p| [p.x, p.y])
+                .collect();
+            segments(
+                &points,
+                segmented
+                    .c_edges
+                    .iter()
+                    .map(|e| e.vertices.map(|v| v.index() as u32)),
+            )
+        };
+        pictures.add("imesh", || {
+            let (vertices, triangles, labels) = segmented.arrays();
+            let elements = triangles.into_iter().map(Element::Triangle).collect();
+            (vertices, elements, labels, c_edge_lines(&segmented))
+        });
+        pictures.add("c-edges", || {
+            (Vec::new(), Vec::new(), Vec::new(), c_edge_lines(&segmented))
+        });
         let mut optimised = None;
         let (vertices, elements, labels) = match o.elements {
             Elements::Tri => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
-            Elements::Quad => self.quads(&segmented, &mut counts, &mut seconds, &mut optimised)?,
+            Elements::Quad => self.quads(
+                &segmented,
+                &mut counts,
+                &mut seconds,
+                &mut optimised,
+                &mut pictures,
+            )?,
         };
+        pictures.add("result", || {
+            (
+                vertices.clone(),
+                elements.clone(),
+                labels.clone(),
+                Vec::new(),
+            )
+        });
         let check = Instant::now();
         self.stage(Stage::Check);
         let checked = validate(
@@ -702,7 +809,12 @@ impl Pipeline {
                 area_ratio: checked.area / (f64::from(w) * f64::from(h)),
             },
         };
-        Ok(PipelineResult { mesh, report })
+        Ok(PipelineResult {
+            mesh,
+            report,
+            stages: pictures.list,
+            label_picture,
+        })
     }
 
     /// The Imesh triangle output: label-aware Ruppert refinement.
@@ -739,6 +851,7 @@ impl Pipeline {
         counts: &mut Counts,
         seconds: &mut StageSeconds,
         optimised: &mut Option<QuadExtras>,
+        pictures: &mut Pictures,
     ) -> Result<MeshArrays, PipelineError> {
         let o = &self.options;
         let start = Instant::now();
@@ -766,6 +879,16 @@ impl Pipeline {
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
         seconds.curves = start.elapsed().as_secs_f64();
+        pictures.add("simplified", || {
+            let points: Vec<[f64; 2]> = simplified
+                .graph
+                .points()
+                .iter()
+                .map(|p| [p.x, p.y])
+                .collect();
+            let lines = segments(&points, simplified.graph.edges().iter().map(|e| e.ends));
+            (Vec::new(), Vec::new(), Vec::new(), lines)
+        });
         self.stage(Stage::Quads);
         let mut r = remesh(
             &simplified.graph,
@@ -797,6 +920,62 @@ impl Pipeline {
                 r.adaptation.invalid_left
             )));
         }
+        let straight: Vec<[f64; 2]> = if pictures.on {
+            r.straight_vertices.iter().map(|p| [p.x, p.y]).collect()
+        } else {
+            Vec::new()
+        };
+        let graph_lines = || {
+            let points: Vec<[f64; 2]> = simplified
+                .graph
+                .points()
+                .iter()
+                .map(|p| [p.x, p.y])
+                .collect();
+            segments(&points, simplified.graph.edges().iter().map(|e| e.ends))
+        };
+        pictures.add("dt", || {
+            let t = &r.dt.triangulation;
+            let points: Vec<[f64; 2]> = t.points().iter().map(|p| [p.x, p.y]).collect();
+            let (mut elements, mut labels) = (Vec::new(), Vec::new());
+            for f in t.triangles() {
+                elements.push(Element::Triangle(
+                    t.triangle_vertices(f).map(|v| v.index() as u32),
+                ));
+                labels.push(t.label(f));
+            }
+            (points, elements, labels, graph_lines())
+        });
+        pictures.add("pairing", || {
+            let elements = r
+                .elements
+                .elements
+                .iter()
+                .map(|e| match *e {
+                    imesh_quad::Element::Triangle(c) => Element::Triangle(c),
+                    imesh_quad::Element::Quad(c) => Element::Quad(c),
+                })
+                .collect();
+            (
+                straight.clone(),
+                elements,
+                r.elements.labels.clone(),
+                graph_lines(),
+            )
+        });
+        let quad_elements = || r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
+        pictures.add("templates", || {
+            (
+                straight.clone(),
+                quad_elements(),
+                r.mesh.labels.clone(),
+                Vec::new(),
+            )
+        });
+        pictures.add("adapted", || {
+            let points = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
+            (points, quad_elements(), r.mesh.labels.clone(), Vec::new())
+        });
         self.stage(Stage::Optimise);
         let (sas_before, sj_before) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         let optimisation = optimise(

@@ -11,8 +11,8 @@ use imesh::{
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
-    read_mesh, write_atomic, write_histogram, write_inp, write_msh, write_png, write_svg,
-    write_vtk, write_vtu, Frame, HistogramPanel, SvgOptions,
+    read_mesh, svg_string, write_atomic, write_histogram, write_inp, write_msh, write_png,
+    write_svg, write_vtk, write_vtu, Frame, HistogramPanel, SvgOptions,
 };
 use imesh_quality::{Element, QuadQuality, TriangleQuality};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -70,6 +70,11 @@ struct MeshArgs {
     /// Also draw the quality histograms before and after optimisation (PNG; quads only).
     #[arg(long)]
     histogram: Option<PathBuf>,
+    /// Also draw every stage into this folder (created if needed): the labels, the Imesh
+    /// triangles, the c-edges, the simplified boundaries G', DT', the pairing, the template
+    /// mesh, the adapted mesh and the result, as SVG over the label image.
+    #[arg(long)]
+    stages: Option<PathBuf>,
     /// Also write the JSON report (counts, per-stage seconds, quality, label agreement).
     #[arg(long)]
     report: Option<PathBuf>,
@@ -302,6 +307,43 @@ fn write_report(path: &Path, report: &imesh::Report) -> Result<(), String> {
     write_atomic(path, json.as_bytes()).map_err(|e| e.to_string())
 }
 
+/// Writes the label image and one SVG per stage picture into `dir`.
+fn write_stages(
+    dir: &Path,
+    mesh: &SegmentedMeshData,
+    stages: &[imesh::StagePicture],
+    labels: Option<&image::RgbImage>,
+) -> Result<(), String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create the stages folder {}: {e}", dir.display()))?;
+    let background = "00-labels.png";
+    if let Some(picture) = labels {
+        let mut png = Vec::new();
+        picture
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .map_err(|e| e.to_string())?;
+        write_atomic(&dir.join(background), &png).map_err(|e| e.to_string())?;
+    }
+    for stage in stages {
+        let picture = SegmentedMeshData {
+            vertices: stage.vertices.clone(),
+            elements: stage.elements.clone(),
+            labels: stage.labels.clone(),
+            ..mesh.clone()
+        };
+        let options = SvgOptions {
+            background: Some(background.into()),
+            fill_opacity: 0.75,
+            overlay: stage.lines.clone(),
+            ..SvgOptions::default()
+        };
+        let path = dir.join(format!("{}.svg", stage.name));
+        write_atomic(&path, svg_string(&picture, &options).as_bytes())
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
 fn quality_command(args: &QualityArgs) -> Result<(), String> {
     let mesh = read_mesh(&args.mesh).map_err(|e| e.to_string())?;
     let (mut quads, mut triangles) = (Vec::new(), Vec::new());
@@ -399,11 +441,22 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         bar
     };
     let shown = bar.clone();
-    let result = Pipeline::new(options)
-        .with_progress(move |stage| shown.set_message(stage.description()))
-        .run_path(&args.image);
+    let mut pipeline =
+        Pipeline::new(options).with_progress(move |stage| shown.set_message(stage.description()));
+    if args.stages.is_some() {
+        pipeline = pipeline.with_stages();
+    }
+    let result = pipeline.run_path(&args.image);
     bar.finish_and_clear();
-    let PipelineResult { mesh, report } = result.map_err(|e| e.to_string())?;
+    let PipelineResult {
+        mesh,
+        report,
+        stages,
+        label_picture,
+    } = result.map_err(|e| e.to_string())?;
+    if let Some(dir) = &args.stages {
+        write_stages(dir, &mesh, &stages, label_picture.as_ref())?;
+    }
     write_mesh(&output, &format, &mesh, &frame)?;
     if let Some(svg) = &args.svg {
         write_svg(svg, &mesh, &SvgOptions::default()).map_err(|e| e.to_string())?;
@@ -518,7 +571,7 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let PipelineResult { mesh, report } =
+            let PipelineResult { mesh, report, .. } =
                 pipeline.run_path(image).map_err(|e| e.to_string())?;
             let output = args.output.join(&stem).with_extension(&format);
             write_mesh(&output, &format, &mesh, &frame)?;

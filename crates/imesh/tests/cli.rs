@@ -556,3 +556,71 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
         );
     }
 }
+
+#[test]
+fn stages_draws_every_step_of_the_pipeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("stardist-mask2d_labels.png");
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "-o",
+            "m.msh",
+            "--stages",
+            "stages",
+            "--report",
+            "r.json",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(dir.path().join("stages"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "00-labels.png",
+            "01-imesh.svg",
+            "02-c-edges.svg",
+            "03-simplified.svg",
+            "04-dt.svg",
+            "05-pairing.svg",
+            "06-templates.svg",
+            "07-adapted.svg",
+            "08-result.svg"
+        ]
+    );
+    let read = |name: &str| std::fs::read_to_string(dir.path().join("stages").join(name)).unwrap();
+    let polygons = |svg: &str| svg.matches("<polygon").count() as u64;
+    let segments = |svg: &str| svg.matches('M').count() as u64;
+    let count = |key: &str| report["counts"][key].as_u64().unwrap();
+    assert_eq!(segments(&read("02-c-edges.svg")), count("c_edges"));
+    assert_eq!(
+        segments(&read("03-simplified.svg")),
+        count("simplified_edges")
+    );
+    assert_eq!(polygons(&read("04-dt.svg")), count("dt_triangles"));
+    let pairs = count("dt_triangles") - count("unpaired_triangles");
+    assert_eq!(
+        polygons(&read("05-pairing.svg")),
+        count("unpaired_triangles") + pairs / 2
+    );
+    for name in ["06-templates.svg", "07-adapted.svg", "08-result.svg"] {
+        let svg = read(name);
+        assert_eq!(polygons(&svg), count("quads"), "{name}");
+        assert!(svg.contains("href=\"00-labels.png\"") && svg.trim_end().ends_with("</svg>"));
+    }
+    let labels = image::open(dir.path().join("stages/00-labels.png")).unwrap();
+    assert_eq!((labels.width(), labels.height()), (512, 512));
+}
