@@ -420,6 +420,28 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         }
     };
     let format = format_of(&output)?;
+    // Refuse a missing output folder before the work, not after it.
+    for path in [
+        Some(&output),
+        args.svg.as_ref(),
+        args.png.as_ref(),
+        args.histogram.as_ref(),
+        args.report.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+        if let Some(folder) = parent {
+            if !folder.is_dir() {
+                return Err(format!(
+                    "the folder {} of {} does not exist: create it or write elsewhere",
+                    folder.display(),
+                    path.display()
+                ));
+            }
+        }
+    }
     if args.histogram.is_some() && options.elements == Elements::Tri {
         return Err(
             "--histogram shows the quads' quality before and after optimisation: drop --elements tri"

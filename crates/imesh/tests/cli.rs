@@ -289,7 +289,13 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
     let image = image.to_str().unwrap();
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 14] = [
+        (&["mesh", image, "--frobnicate"], "unexpected argument"),
+        (
+            &["mesh", image, "--classify", "bogus:3"],
+            "unknown classifier",
+        ),
+        (&["mesh", image, "-o", "nodir/m.msh"], "does not exist"),
         (&["mesh", "missing.png"], "missing.png"),
         (&["mesh", image, "-o", "out.obj"], ".msh"),
         (&["mesh", image, "--te", "2"], "t_e"),

@@ -23,72 +23,91 @@ fn meshio_read(python: &str, file: &Path) -> serde_json::Value {
 }
 
 #[test]
-fn meshio_reads_our_msh_and_vtu() {
+fn meshio_reads_every_format_we_write() {
     let Ok(python) = std::env::var("IMESH_PYTHON") else {
         eprintln!("IMESH_PYTHON is not set: skipping the meshio check (.ci/run sets it up: python3 -m venv target/venv-io && target/venv-io/bin/pip install meshio)");
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let image = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images/pyvista-channels_z050_labels.png");
-    for (name, pixel) in [("m.msh", "1"), ("m.vtu", "0.5")] {
-        let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
-            .args([
-                "mesh",
-                image.to_str().unwrap(),
-                "-o",
-                name,
-                "--pixel-size",
-                pixel,
-                "--report",
-                "r.json",
-                "-q",
-            ])
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
+    let fixtures = [
+        ("pyvista-channels_z050_labels.png", 250.0, 250.0),
+        ("stardist-mask2d_labels.png", 512.0, 512.0),
+    ];
+    for (fixture, width, height) in fixtures {
+        let image = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/images")
+            .join(fixture);
+        for (name, pixel) in [
+            ("m.msh", "1"),
+            ("m.vtu", "0.5"),
+            ("m.vtk", "2"),
+            ("m.inp", "1"),
+        ] {
+            let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
+                .args([
+                    "mesh",
+                    image.to_str().unwrap(),
+                    "-o",
+                    name,
+                    "--pixel-size",
+                    pixel,
+                    "--report",
+                    "r.json",
+                    "-q",
+                ])
+                .current_dir(dir.path())
+                .output()
                 .unwrap();
-        let read = meshio_read(&python, &dir.path().join(name));
-        assert_eq!(read["points"], report["counts"]["vertices"], "{name}");
-        // The default mesh is all quads.
-        assert_eq!(read["cells"]["quad"], report["counts"]["quads"], "{name}");
-        assert_eq!(
-            read["cells"]["quad"], report["counts"]["elements"],
-            "{name}"
-        );
-        assert!(read["cells"]["triangle"].is_null(), "{name}: no triangles");
-        assert_eq!(
-            read["negative"], 0,
-            "{name}: clockwise elements in the written frame"
-        );
-        let s: f64 = pixel.parse().unwrap();
-        let want = 250.0 * 250.0 * s * s;
-        assert!(
-            (read["area"].as_f64().unwrap() - want).abs() < 1e-6 * want,
-            "{name}: area {}",
-            read["area"]
-        );
-        if name.ends_with(".msh") {
-            assert_eq!(read["physical"], serde_json::json!([1, 2, 3, 4, 5]));
-            // Five named surfaces, and named curves for the boundaries, the border among them.
-            let names: Vec<&str> = read["names"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|n| n.as_str().unwrap())
-                .collect();
-            assert!(names.len() > 5, "{names:?}");
-            assert!(names.iter().any(|n| n.starts_with("border_")), "{names:?}");
-            assert!(read["cells"]["line"].as_u64().unwrap() > 0);
-        } else {
-            assert_eq!(read["labels"], serde_json::json!([0, 1, 2, 3, 4]));
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let report: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
+                    .unwrap();
+            let what = format!("{fixture} {name}");
+            let read = meshio_read(&python, &dir.path().join(name));
+            assert_eq!(read["points"], report["counts"]["vertices"], "{what}");
+            // The default mesh is all quads.
+            assert_eq!(read["cells"]["quad"], report["counts"]["quads"], "{what}");
+            assert_eq!(
+                read["cells"]["quad"], report["counts"]["elements"],
+                "{what}"
+            );
+            assert!(read["cells"]["triangle"].is_null(), "{what}: no triangles");
+            assert_eq!(
+                read["negative"], 0,
+                "{what}: clockwise elements in the written frame"
+            );
+            let s: f64 = pixel.parse().unwrap();
+            let want = width * height * s * s;
+            assert!(
+                (read["area"].as_f64().unwrap() - want).abs() < 1e-6 * want,
+                "{what}: area {}",
+                read["area"]
+            );
+            let labels = report["counts"]["labels"].as_u64().unwrap();
+            let count = |key: &str| read[key].as_array().unwrap().len() as u64;
+            if name.ends_with(".msh") {
+                assert_eq!(count("physical"), labels, "{what}");
+                // Named surfaces, and named curves for the boundaries, the border among them.
+                let names: Vec<&str> = read["names"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|n| n.as_str().unwrap())
+                    .collect();
+                assert!(names.len() as u64 > labels, "{what}: {names:?}");
+                assert!(names.iter().any(|n| n.starts_with("border_")), "{what}");
+                assert!(read["cells"]["line"].as_u64().unwrap() > 0, "{what}");
+            } else if name.ends_with(".inp") {
+                // An element set per label.
+                assert_eq!(count("cell_sets"), labels, "{what}");
+            } else {
+                let want: Vec<u64> = (0..labels).collect();
+                assert_eq!(read["labels"], serde_json::json!(want), "{what}");
+            }
         }
     }
 }

@@ -114,3 +114,33 @@ fn the_triangle_path_stays_available() {
         assert_eq!(result.report.counts.quads, 0, "{name}");
     }
 }
+
+#[test]
+fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images");
+    let mut images: Vec<_> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    images.sort();
+    assert!(images.len() >= 10, "{images:?}");
+    for path in images {
+        let quads = Pipeline::new(MeshOptions::default()).run_path(&path).unwrap();
+        let r = &quads.report;
+        // The pipeline refuses to return a mesh that fails the validator; check it said so.
+        assert!(r.validation.valid, "{}", path.display());
+        assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "{}", path.display());
+        assert!(r.counts.quads > 0 && r.counts.triangles == 0, "{}", path.display());
+        assert!(r.label_agreement > 0.9, "{}: {}", path.display(), r.label_agreement);
+        let tri = Pipeline::new(MeshOptions {
+            elements: Elements::Tri,
+            ..MeshOptions::default()
+        })
+        .run_path(&path)
+        .unwrap();
+        let t = &tri.report;
+        assert!(t.validation.valid, "{}", path.display());
+        assert!(t.counts.triangles > 0 && t.counts.quads == 0, "{}", path.display());
+    }
+}

@@ -8,7 +8,7 @@ mesh = meshio.read(sys.argv[1])
 cells = {}
 for block in mesh.cells:
     cells[block.type] = cells.get(block.type, 0) + int(len(block.data))
-labels = sorted({int(v) for block in mesh.cell_data.get("label", []) for v in block})
+labels = sorted({int(v) for block in mesh.cell_data.get("label", []) for v in block.ravel()})
 physical = sorted({
     int(v)
     for block, tags in zip(mesh.cells, mesh.cell_data.get("gmsh:physical", []))
@@ -32,6 +32,7 @@ print(json.dumps({
     "labels": labels,
     "physical": physical,
     "names": sorted(mesh.field_data.keys()),
+    "cell_sets": sorted(mesh.cell_sets.keys()),
     "negative": int(negative),
     "area": float(area),
 }))
