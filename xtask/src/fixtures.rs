@@ -11,7 +11,7 @@ const VTK_VERSION: &str = "9.7.2";
 /// The files the script writes under `fixtures/quality/`.
 const OUTPUTS: [&str; 2] = ["verdict-quads.csv", "verdict-triangles.csv"];
 
-fn workspace_root() -> Result<PathBuf, String> {
+pub fn workspace_root() -> Result<PathBuf, String> {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .map(Path::to_path_buf)
@@ -31,7 +31,23 @@ fn run(cmd: &mut Command, what: &str) -> Result<(), String> {
 
 /// A virtual environment under `target/` with `vtk` installed; returns its Python.
 fn vtk_python(root: &Path) -> Result<PathBuf, String> {
-    let venv = root.join("target").join("venv-vtk");
+    venv_python(
+        root,
+        "venv-vtk",
+        &format!("import vtk, sys; sys.exit(vtk.vtkVersion.GetVTKVersion() != '{VTK_VERSION}')"),
+        &format!("vtk=={VTK_VERSION}"),
+    )
+}
+
+/// The Python of `target/<venv>`, created if needed, with `requirement` installed from PyPI
+/// unless `check` (a Python snippet) already succeeds.
+pub fn venv_python(
+    root: &Path,
+    venv: &str,
+    check: &str,
+    requirement: &str,
+) -> Result<PathBuf, String> {
+    let venv = root.join("target").join(venv);
     let python = venv.join("bin").join("python");
     if !python.exists() {
         run(
@@ -39,32 +55,20 @@ fn vtk_python(root: &Path) -> Result<PathBuf, String> {
             "creating a Python virtual environment (is python3 with venv installed?)",
         )?;
     }
-    let has_vtk = Command::new(&python)
-        .args([
-            "-c",
-            &format!(
-                "import vtk, sys; sys.exit(vtk.vtkVersion.GetVTKVersion() != '{VTK_VERSION}')"
-            ),
-        ])
+    let ready = Command::new(&python)
+        .args(["-c", check])
         .status()
         .map(|s| s.success())
         .unwrap_or(false);
-    if !has_vtk {
+    if !ready {
         run(
-            Command::new(&python).args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                &format!("vtk=={VTK_VERSION}"),
-            ]),
-            "installing vtk from PyPI (is PyPI reachable?)",
+            Command::new(&python).args(["-m", "pip", "install", "--quiet", requirement]),
+            &format!("installing {requirement} from PyPI (is PyPI reachable?)"),
         )?;
     }
     Ok(python)
 }
 
-/// Regenerates `fixtures/quality/` and says which files changed.
 pub fn quality() -> Result<(), String> {
     let root = workspace_root()?;
     let out = root.join("fixtures").join("quality");

@@ -4,6 +4,7 @@
 //! cargo xtask bench delaunay [--runs N] [--quick]
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
+//! cargo xtask compare gmsh
 //! cargo xtask fixtures quality
 //! ```
 
@@ -11,6 +12,7 @@ mod alloc;
 mod bench_delaunay;
 mod bench_optim;
 mod bench_refine;
+mod compare_gmsh;
 mod fixtures;
 
 use std::process::ExitCode;
@@ -18,6 +20,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
+       cargo xtask compare gmsh
        cargo xtask fixtures quality
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
@@ -33,6 +36,11 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    fixtures) through the whole pipeline: worst / mean quality and seconds;
                    writes target/bench/optim.json
     --global-iterations N   Powell iterations of the global mode (default 10)
+
+  compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
+                   same simplified boundaries of five fixtures at about the same quad count,
+                   both measured with our metrics; Gmsh from PyPI into target/venv-gmsh;
+                   writes target/bench/compare-gmsh.json
 
   fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
                    vtkMeshQuality, installed from PyPI into target/venv-vtk";
@@ -96,6 +104,7 @@ fn run(args: &[String]) -> Result<(), String> {
             };
             bench_optim::run(iterations)
         }
+        ["compare", "gmsh"] => compare_gmsh::run(),
         ["fixtures", "quality"] => fixtures::quality(),
         [] | ["help"] | ["--help"] | ["-h"] => {
             println!("{USAGE}");

@@ -126,13 +126,28 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
     images.sort();
     assert!(images.len() >= 10, "{images:?}");
     for path in images {
-        let quads = Pipeline::new(MeshOptions::default()).run_path(&path).unwrap();
+        let quads = Pipeline::new(MeshOptions::default())
+            .run_path(&path)
+            .unwrap();
         let r = &quads.report;
         // The pipeline refuses to return a mesh that fails the validator; check it said so.
         assert!(r.validation.valid, "{}", path.display());
-        assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "{}", path.display());
-        assert!(r.counts.quads > 0 && r.counts.triangles == 0, "{}", path.display());
-        assert!(r.label_agreement > 0.9, "{}: {}", path.display(), r.label_agreement);
+        assert!(
+            (r.validation.area_ratio - 1.0).abs() < 1e-9,
+            "{}",
+            path.display()
+        );
+        assert!(
+            r.counts.quads > 0 && r.counts.triangles == 0,
+            "{}",
+            path.display()
+        );
+        assert!(
+            r.label_agreement > 0.9,
+            "{}: {}",
+            path.display(),
+            r.label_agreement
+        );
         let tri = Pipeline::new(MeshOptions {
             elements: Elements::Tri,
             ..MeshOptions::default()
@@ -141,6 +156,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         .unwrap();
         let t = &tri.report;
         assert!(t.validation.valid, "{}", path.display());
-        assert!(t.counts.triangles > 0 && t.counts.quads == 0, "{}", path.display());
+        assert!(
+            t.counts.triangles > 0 && t.counts.quads == 0,
+            "{}",
+            path.display()
+        );
     }
 }

@@ -1,0 +1,235 @@
+//! `cargo xtask compare gmsh`: our quad mesh against Gmsh's on the same simplified boundary
+//! graph G' of each fixture, at about the same number of quads, both measured with our metrics.
+//!
+//! Gmsh (the `gmsh` PyPI package, installed into `target/venv-gmsh`) gets G' as lines cutting the
+//! domain rectangle (OpenCASCADE fragment) and meshes every piece with quads twice: Frontal-Delaunay
+//! for quads with Blossom full-quad recombination, and its quasi-structured algorithm. Its time is
+//! the meshing call alone (no geometry, no classification, no sampling); ours is the whole run,
+//! image to optimised quads.
+
+use std::io::Write as _;
+use std::process::{Command, Stdio};
+
+use imesh::{MeshOptions, Pipeline};
+use imesh_geom::predicates::orient2d;
+use imesh_geom::Point;
+use imesh_quality::QuadQuality;
+use serde::{Deserialize, Serialize};
+
+const FIXTURES: [&str; 5] = [
+    "matplotlib-s1045_mri.png",
+    "stardist-mask2d_labels.png",
+    "skimage-coins.png",
+    "pyvista-channels_z050_labels.png",
+    "skimage-camera.png",
+];
+
+const GMSH: &str = "gmsh==4.15.2";
+
+#[derive(Deserialize)]
+struct GmshMesh {
+    nodes: Vec<[f64; 2]>,
+    quads: Vec<[u32; 4]>,
+    triangles: Vec<[u32; 3]>,
+    seconds: f64,
+}
+
+#[derive(Serialize)]
+struct Side {
+    quads: usize,
+    triangles: usize,
+    invalid_quads: usize,
+    seconds: f64,
+    shape_and_size_min: f64,
+    shape_and_size_mean: f64,
+    scaled_jacobian_min: f64,
+    scaled_jacobian_mean: f64,
+}
+
+#[derive(Serialize)]
+struct Row {
+    fixture: String,
+    ours: Side,
+    blossom: Option<Side>,
+    quasi_structured: Option<Side>,
+}
+
+/// Quads with a non-positive Jacobian at some corner (exact orientation).
+fn invalid(vertices: &[[f64; 2]], quads: &[[u32; 4]]) -> usize {
+    quads
+        .iter()
+        .filter(|q| {
+            let p = q.map(|v| Point::new(vertices[v as usize][0], vertices[v as usize][1]));
+            (0..4).any(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) <= 0.0)
+        })
+        .count()
+}
+
+fn side(vertices: &[[f64; 2]], quads: &[[u32; 4]], triangles: usize, seconds: f64) -> Side {
+    let q = QuadQuality::of(vertices, quads);
+    Side {
+        quads: quads.len(),
+        triangles,
+        invalid_quads: invalid(vertices, quads),
+        seconds,
+        shape_and_size_min: q.shape_and_size.min,
+        shape_and_size_mean: q.shape_and_size.mean,
+        scaled_jacobian_min: q.scaled_jacobian.min,
+        scaled_jacobian_mean: q.scaled_jacobian.mean,
+    }
+}
+
+fn gmsh(python: &std::path::Path, spec: &serde_json::Value) -> Result<GmshMesh, String> {
+    let script = crate::fixtures::workspace_root()?.join("xtask/scripts/mesh_graph.py");
+    let mut child = Command::new(python)
+        .arg(script)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start Gmsh's Python: {e}"))?;
+    child
+        .stdin
+        .take()
+        .ok_or("no stdin")?
+        .write_all(spec.to_string().as_bytes())
+        .map_err(|e| e.to_string())?;
+    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    if !out.status.success() {
+        return Err(format!(
+            "Gmsh failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    serde_json::from_slice(&out.stdout).map_err(|e| format!("Gmsh's output: {e}"))
+}
+
+fn cell(s: &Option<Side>, ours: &Side) -> String {
+    match s {
+        None => "failed | | | ".into(),
+        Some(s) => format!(
+            "{} + {} tri, {} inv | {:.3} / {:.3} | {:.3} / {:.3} | {:.2} s ({:.2}×)",
+            s.quads,
+            s.triangles,
+            s.invalid_quads,
+            s.shape_and_size_min,
+            s.shape_and_size_mean,
+            s.scaled_jacobian_min,
+            s.scaled_jacobian_mean,
+            s.seconds,
+            ours.seconds / s.seconds
+        ),
+    }
+}
+
+/// Runs the comparison on the fixtures and writes `target/bench/compare-gmsh.json`.
+pub fn run() -> Result<(), String> {
+    let root = crate::fixtures::workspace_root()?;
+    let python = crate::fixtures::venv_python(&root, "venv-gmsh", "import gmsh", GMSH)?;
+    let mut rows = Vec::new();
+    println!("| fixture | ours: quads | S&S worst / mean | SJ worst / mean | s | Blossom: quads | S&S | SJ | s (ours/Gmsh) | quasi-structured: quads | S&S | SJ | s (ours/Gmsh) |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for file in FIXTURES {
+        let path = root.join("fixtures/images").join(file);
+        // Our whole run, timed alone, then once more for G' (the stage pictures).
+        let ours = Pipeline::new(MeshOptions::default())
+            .run_path(&path)
+            .map_err(|e| format!("{file}: {e}"))?;
+        let staged = Pipeline::new(MeshOptions::default())
+            .with_stages()
+            .run_path(&path)
+            .map_err(|e| format!("{file}: {e}"))?;
+        let g = staged
+            .stages
+            .iter()
+            .find(|s| s.name.ends_with("simplified"))
+            .ok_or("no G' picture")?;
+        let (w, h) = (f64::from(ours.mesh.width), f64::from(ours.mesh.height));
+        // G' as points and edges, y up so that Gmsh's elements are counter-clockwise.
+        let mut index = std::collections::HashMap::new();
+        let mut points: Vec<[f64; 2]> = Vec::new();
+        let mut edges = Vec::new();
+        for segment in &g.lines {
+            let ends = segment.map(|p| {
+                let key = (p[0].to_bits(), p[1].to_bits());
+                *index.entry(key).or_insert_with(|| {
+                    points.push([p[0], h - p[1]]);
+                    points.len() - 1
+                })
+            });
+            edges.push(ends);
+        }
+        let our_vertices = ours.mesh.vertices.clone();
+        let our_quads: Vec<[u32; 4]> = ours
+            .mesh
+            .elements
+            .iter()
+            .filter_map(|e| match e {
+                imesh_quality::Element::Quad(q) => Some(*q),
+                imesh_quality::Element::Triangle(_) => None,
+            })
+            .collect();
+        let our_side = side(&our_vertices, &our_quads, 0, ours.report.seconds.total);
+        let target = our_quads.len() as f64;
+        let peer = |algorithm: &str| -> Option<Side> {
+            // Quads of side lc: about area / lc² (Blossom full-quad splits every quad of its
+            // mesh at 2 lc in four); a second run only when the count is off by over 30 %.
+            let full_quad = if algorithm == "blossom" { 2.0 } else { 1.0 };
+            let mut lc = full_quad * (w * h / target).sqrt();
+            let mut last: Option<GmshMesh> = None;
+            for _ in 0..2 {
+                if let Some(m) = &last {
+                    let count = (m.quads.len() + m.triangles.len()) as f64;
+                    if (count / target - 1.0).abs() <= 0.3 {
+                        break;
+                    }
+                }
+                let spec = serde_json::json!({
+                    "width": w, "height": h, "points": points, "edges": edges,
+                    "size": lc, "algorithm": algorithm,
+                });
+                if std::env::var_os("IMESH_DUMP_SPEC").is_some() {
+                    let dump = root
+                        .join("target/bench")
+                        .join(format!("{file}.{algorithm}.json"));
+                    let _ = std::fs::write(dump, spec.to_string());
+                }
+                let m = match gmsh(&python, &spec) {
+                    Ok(m) => m,
+                    Err(e) => {
+                        eprintln!("{file} {algorithm}: {e}");
+                        return None;
+                    }
+                };
+                let count = (m.quads.len() + m.triangles.len()).max(1) as f64;
+                lc *= (count / target).sqrt();
+                last = Some(m);
+            }
+            last.map(|m| side(&m.nodes, &m.quads, m.triangles.len(), m.seconds))
+        };
+        let blossom = peer("blossom");
+        let quasi = peer("quasi-structured");
+        println!(
+            "| {file} | {} | {:.3} / {:.3} | {:.3} / {:.3} | {:.2} | {} | {} |",
+            our_side.quads,
+            our_side.shape_and_size_min,
+            our_side.shape_and_size_mean,
+            our_side.scaled_jacobian_min,
+            our_side.scaled_jacobian_mean,
+            our_side.seconds,
+            cell(&blossom, &our_side),
+            cell(&quasi, &our_side),
+        );
+        rows.push(Row {
+            fixture: file.into(),
+            ours: our_side,
+            blossom,
+            quasi_structured: quasi,
+        });
+    }
+    let out = crate::bench_dir()?.join("compare-gmsh.json");
+    let text = serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?;
+    std::fs::write(&out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    println!("\nwritten {}", out.display());
+    Ok(())
+}
