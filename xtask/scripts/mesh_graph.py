@@ -31,7 +31,10 @@ gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
 gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
 if spec["algorithm"] == "blossom":
     gmsh.option.setNumber("Mesh.Algorithm", 8)  # Frontal-Delaunay for quads
-    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 3)  # Blossom full-quad
+    # Blossom recombination, then the all-quad subdivision of the hybrid mesh (Gmsh's full-quad
+    # recombination, algorithm 3, refuses curves of a single segment, which G' has).
+    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+    gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
 else:
     gmsh.option.setNumber("Mesh.Algorithm", 11)  # quasi-structured quads
 gmsh.option.setNumber("Mesh.RecombineAll", 1)
