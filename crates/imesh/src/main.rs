@@ -64,6 +64,10 @@ struct MeshArgs {
     /// Also draw the mesh as SVG.
     #[arg(long)]
     svg: Option<PathBuf>,
+    /// Draw the SVG over the input image (referred to by its absolute path), elements
+    /// half-transparent.
+    #[arg(long, requires = "svg")]
+    svg_over_image: bool,
     /// Also draw the mesh as PNG.
     #[arg(long)]
     png: Option<PathBuf>,
@@ -481,7 +485,18 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     }
     write_mesh(&output, &format, &mesh, &frame)?;
     if let Some(svg) = &args.svg {
-        write_svg(svg, &mesh, &SvgOptions::default()).map_err(|e| e.to_string())?;
+        let options = if args.svg_over_image {
+            let image = std::fs::canonicalize(&args.image)
+                .map_err(|e| format!("cannot resolve {}: {e}", args.image.display()))?;
+            SvgOptions {
+                background: Some(image.display().to_string()),
+                fill_opacity: 0.5,
+                ..SvgOptions::default()
+            }
+        } else {
+            SvgOptions::default()
+        };
+        write_svg(svg, &mesh, &options).map_err(|e| e.to_string())?;
     }
     if let Some(png) = &args.png {
         write_png(png, &mesh).map_err(|e| e.to_string())?;

@@ -630,3 +630,40 @@ fn stages_draws_every_step_of_the_pipeline() {
     let labels = image::open(dir.path().join("stages/00-labels.png")).unwrap();
     assert_eq!((labels.width(), labels.height()), (512, 512));
 }
+
+#[test]
+fn the_svg_can_be_drawn_over_the_input_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coins.png");
+    let args = [
+        "mesh",
+        image.to_str().unwrap(),
+        "-o",
+        "m.msh",
+        "--svg",
+        "m.svg",
+        "-q",
+    ];
+    let out = imesh(&[&args[..], &["--svg-over-image"]].concat(), dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(dir.path().join("m.svg")).unwrap();
+    let href = svg
+        .split("<image href=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap();
+    assert!(std::path::Path::new(href).is_absolute() && href.ends_with("skimage-coins.png"));
+    assert!(std::path::Path::new(href).exists());
+    assert!(svg.contains("fill-opacity=\"0.5\""));
+    // Without the flag: no background, opaque elements.
+    let out = imesh(&args, dir.path());
+    assert!(out.status.success());
+    let plain = std::fs::read_to_string(dir.path().join("m.svg")).unwrap();
+    assert!(!plain.contains("<image") && plain.contains("fill-opacity=\"1\""));
+}
