@@ -40,3 +40,29 @@ impl Metric {
 pub fn is_valid(p: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) > 0.0)
 }
+
+/// The signed (shoelace) area of the quad `p`.
+#[inline]
+pub(crate) fn area(p: &[Point; 4]) -> f64 {
+    0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y))
+}
+
+/// Verdict's shape at corner `k` of `p`: `2 α / (|a|² + |b|²)`, `α = a × b`, with
+/// `a = p_k − p_{k−1}` and `b = p_{k+1} − p_k`; the quad's shape is the least over its corners.
+#[inline]
+pub(crate) fn corner_shape(p: &[Point; 4], k: usize) -> f64 {
+    let (a, b) = (p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+    2.0 * (a.x * b.y - a.y * b.x) / (a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y)
+}
+
+/// The corner of `p` with the least [`corner_shape`] (the first of equals).
+#[inline]
+pub(crate) fn worst_corner(p: &[Point; 4]) -> usize {
+    (1..4).fold(0, |k, j| {
+        if corner_shape(p, j) < corner_shape(p, k) {
+            j
+        } else {
+            k
+        }
+    })
+}

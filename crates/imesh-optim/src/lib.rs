@@ -53,6 +53,8 @@ mod powell;
 mod variables;
 
 pub use energy::{is_valid, Metric};
+
+use energy::worst_corner;
 pub use powell::Powell;
 
 use std::time::Instant;
@@ -206,10 +208,7 @@ impl Setup<'_> {
         let s = match self.metric {
             Metric::Shape => shape,
             Metric::ShapeAndSize => {
-                let area = 0.5
-                    * ((p[2].x - p[0].x) * (p[3].y - p[1].y)
-                        - (p[3].x - p[1].x) * (p[2].y - p[0].y));
-                let r = area / self.average_area;
+                let r = energy::area(p) / self.average_area;
                 let m = if r > 0.0 { r.min(1.0 / r) } else { 0.0 };
                 shape * m * m
             }
@@ -221,31 +220,29 @@ impl Setup<'_> {
     /// below a floor.
     #[inline]
     pub fn term(&self, quad: usize, p: &[Point; 4]) -> Option<f64> {
+        self.feasible_quality(quad, p)
+            .map(|(s, _)| (1.0 - s) * (1.0 - s))
+    }
+
+    /// The metric and the shape of quad `p` when it is valid and above both floors.
+    #[inline]
+    fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
         if !is_valid(p) {
             return None;
         }
         let (s, shape) = self.quality(p);
-        (s >= self.floor && shape >= self.shape_floors[quad]).then_some((1.0 - s) * (1.0 - s))
+        (s >= self.floor && shape >= self.shape_floors[quad]).then_some((s, shape))
     }
 
     /// The energy term of quad `p` and its gradient with respect to each corner (`None` where
     /// [`Setup::term`] is). Shape is the minimum over the corners: its gradient is that of the
     /// worst corner (a subgradient where two tie).
     pub fn term_gradient(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, [Point; 4])> {
-        let e = self.term(quad, p)?;
-        let shape = self.quality(p).1;
-        let mut worst = (f64::INFINITY, 0);
-        for k in 0..4 {
-            let (u, c, v) = (p[(k + 3) % 4], p[k], p[(k + 1) % 4]);
-            let (a, b) = (c - u, v - c);
-            let f = 2.0 * (a.x * b.y - a.y * b.x) / (a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y);
-            if f < worst.0 {
-                worst = (f, k);
-            }
-        }
-        // ∂shape/∂p at the worst corner k: shape = 2α / D, α = a × b, D = |a|² + |b|², with
-        // a = p_k − p_{k−1} and b = p_{k+1} − p_k.
-        let k = worst.1;
+        let (s, shape) = self.feasible_quality(quad, p)?;
+        let e = (1.0 - s) * (1.0 - s);
+        // ∂shape/∂p at the worst corner k (the first of equals): shape = 2α / D, α = a × b,
+        // D = |a|² + |b|², with a = p_k − p_{k−1} and b = p_{k+1} − p_k.
+        let k = worst_corner(p);
         let (u, c, v) = (p[(k + 3) % 4], p[k], p[(k + 1) % 4]);
         let (a, b) = (c - u, v - c);
         let alpha = a.x * b.y - a.y * b.x;
@@ -257,28 +254,21 @@ impl Setup<'_> {
         ds[(k + 3) % 4] = da * -1.0;
         ds[k] = da - db;
         ds[(k + 1) % 4] = db;
-        let s = match self.metric {
-            Metric::Shape => shape,
-            Metric::ShapeAndSize => {
-                // relative size min(R, 1/R)², R = area / Ā, ∂area/∂p_i = ½ (y_{i+1} − y_{i−1},
-                // x_{i−1} − x_{i+1}).
-                let area = 0.5
-                    * ((p[2].x - p[0].x) * (p[3].y - p[1].y)
-                        - (p[3].x - p[1].x) * (p[2].y - p[0].y));
-                let r = area / self.average_area;
-                let (rel, drel) = if r < 1.0 {
-                    (r * r, 2.0 * r)
-                } else {
-                    (1.0 / (r * r), -2.0 / (r * r * r))
-                };
-                for i in 0..4 {
-                    let (next, prev) = (p[(i + 1) % 4], p[(i + 3) % 4]);
-                    let darea = Point::new(next.y - prev.y, prev.x - next.x) * 0.5;
-                    ds[i] = ds[i] * rel + darea * (shape * drel / self.average_area);
-                }
-                shape * rel
+        if self.metric == Metric::ShapeAndSize {
+            // relative size min(R, 1/R)², R = area / Ā, ∂area/∂p_i = ½ (y_{i+1} − y_{i−1},
+            // x_{i−1} − x_{i+1}).
+            let r = energy::area(p) / self.average_area;
+            let (rel, drel) = if r < 1.0 {
+                (r * r, 2.0 * r)
+            } else {
+                (1.0 / (r * r), -2.0 / (r * r * r))
+            };
+            for i in 0..4 {
+                let (next, prev) = (p[(i + 1) % 4], p[(i + 3) % 4]);
+                let darea = Point::new(next.y - prev.y, prev.x - next.x) * 0.5;
+                ds[i] = ds[i] * rel + darea * (shape * drel / self.average_area);
             }
-        };
+        }
         Some((e, ds.map(|g| g * (-2.0 * (1.0 - s)))))
     }
 
@@ -448,21 +438,7 @@ mod tests {
                 };
                 // The shape is a minimum over corners: skip points where the worst corner changes
                 // within the step (the one-sided slopes differ there).
-                let kink = {
-                    let worst = |q: &[Point; 4]| {
-                        (0..4)
-                            .map(|k| {
-                                let (u, c, v) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
-                                let (a, b) = (c - u, v - c);
-                                let f = 2.0 * (a.x * b.y - a.y * b.x)
-                                    / (a.x * a.x + a.y * a.y + b.x * b.x + b.y * b.y);
-                                (f, k)
-                            })
-                            .fold((f64::INFINITY, 0), |m, x| if x.0 < m.0 { x } else { m })
-                            .1
-                    };
-                    worst(&plus) != worst(&minus)
-                };
+                let kink = { worst_corner(&plus) != worst_corner(&minus) };
                 if !kink {
                     prop_assert!(
                         (numeric - analytic).abs() <= 1e-5 * (1.0 + numeric.abs()),

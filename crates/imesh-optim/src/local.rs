@@ -110,8 +110,7 @@ fn solve(
         let quad = setup.quads[q as usize];
         let corners = quad.map(|v| (vertices[v as usize], variables.weight(i, v)));
         let p = corners.map(|(p, _)| p);
-        area +=
-            0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y));
+        area += crate::energy::area(&p);
         scratch.corners.push((q as usize, corners));
     }
     if scratch.corners.is_empty() {
