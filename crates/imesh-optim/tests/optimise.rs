@@ -1,9 +1,7 @@
 //! The optimiser on fixture meshes and random label images: lower energy, valid quads, fixed
 //! boundaries, never a worse worst quad, and the same result on any number of threads.
 
-use std::path::Path;
-
-use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
+use imesh_classify::LabelGrid;
 use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
 use imesh_geom::Point;
 use imesh_optim::{optimise, LocalSolver, Method, Metric, OptimOptions, OptimReport};
@@ -12,18 +10,6 @@ use proptest::prelude::*;
 
 #[path = "../../imesh-curves/tests/support/mod.rs"]
 mod support;
-
-fn fixture(name: &str) -> LabelGrid {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images")
-        .join(name);
-    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
-    if name.contains("labels") {
-        return label_map(&image, 256).unwrap();
-    }
-    let grey = luminance(&image);
-    threshold(&grey, &multi_otsu_levels(&grey, 3))
-}
 
 fn quad_mesh(grid: &LabelGrid) -> Remesh {
     let g = support::imesh_boundaries(grid);
@@ -184,7 +170,7 @@ fn every_method_keeps_fixture_meshes_valid_and_their_boundaries_fixed() {
         "stardist-mask2d_labels.png",
         "pyvista-channels_z050_labels.png",
     ] {
-        let start = quad_mesh(&fixture(name));
+        let start = quad_mesh(&support::fixture(name));
         let (_, local) = check(&start, Method::Local, Metric::ShapeAndSize);
         assert!(
             local.energy_after < local.energy_before,
@@ -208,7 +194,7 @@ fn every_method_keeps_fixture_meshes_valid_and_their_boundaries_fixed() {
 
 #[test]
 fn results_are_identical_on_one_and_two_threads() {
-    let start = quad_mesh(&fixture("stardist-mask2d_labels.png"));
+    let start = quad_mesh(&support::fixture("stardist-mask2d_labels.png"));
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -1,9 +1,8 @@
 //! The quad stage on the fixtures' simplified boundary graphs.
 
 use std::collections::HashMap;
-use std::path::Path;
 
-use imesh_classify::{label_map, luminance, multi_otsu_levels, threshold, LabelGrid};
+use imesh_classify::LabelGrid;
 use imesh_curves::{
     fit_edges, segment_distance, simplify, CurveGraph, FitOptions, SimplifyOptions,
 };
@@ -18,18 +17,6 @@ use imesh_quad::{
 mod support;
 
 const TOLERANCE: f64 = 2.0;
-
-fn fixture(name: &str) -> LabelGrid {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images")
-        .join(name);
-    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
-    if name.contains("labels") {
-        return label_map(&image, 256).unwrap();
-    }
-    let grey = luminance(&image);
-    threshold(&grey, &multi_otsu_levels(&grey, 3))
-}
 
 /// G (the Imesh c-edges) and G' at `TOLERANCE`, with G' edges' fitted curves.
 struct Curves {
@@ -132,7 +119,7 @@ const FIXTURES: [&str; 3] = [
 #[test]
 fn fixtures_give_valid_conforming_quad_meshes_before_and_after_adaptation() {
     for name in FIXTURES {
-        let c = curves(&fixture(name));
+        let c = curves(&support::fixture(name));
         let r = run(&c, &QuadOptions::default());
         assert!(!r.mesh.quads.is_empty());
         check_mesh(&r, &c, &r.straight_vertices);
@@ -151,7 +138,7 @@ fn fixtures_give_valid_conforming_quad_meshes_before_and_after_adaptation() {
 
 #[test]
 fn every_simplified_edge_is_a_union_of_quad_edges_before_adaptation() {
-    let c = curves(&fixture("skimage-coins.png"));
+    let c = curves(&support::fixture("skimage-coins.png"));
     let r = run(&c, &QuadOptions::default());
     let t = &r.dt.triangulation;
     let g = &c.simplified.graph;
@@ -193,7 +180,7 @@ fn every_simplified_edge_is_a_union_of_quad_edges_before_adaptation() {
 #[test]
 fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
     for name in FIXTURES {
-        let c = curves(&fixture(name));
+        let c = curves(&support::fixture(name));
         let r = run(
             &c,
             &QuadOptions {
@@ -237,7 +224,7 @@ fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
 
 #[test]
 fn template_level_k_gives_3k2_and_4k2_quads_per_element() {
-    let c = curves(&fixture("pyvista-channels_z050_labels.png"));
+    let c = curves(&support::fixture("pyvista-channels_z050_labels.png"));
     for k in 1..=3u32 {
         let r = run(
             &c,
@@ -266,7 +253,7 @@ fn template_level_k_gives_3k2_and_4k2_quads_per_element() {
 
 #[test]
 fn every_vertex_is_its_holders_patches_at_its_canonical_coordinates() {
-    let c = curves(&fixture("stardist-mask2d_labels.png"));
+    let c = curves(&support::fixture("stardist-mask2d_labels.png"));
     let r = run(
         &c,
         &QuadOptions {
@@ -292,7 +279,7 @@ fn every_vertex_is_its_holders_patches_at_its_canonical_coordinates() {
 #[test]
 fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
     for name in FIXTURES {
-        let c = curves(&fixture(name));
+        let c = curves(&support::fixture(name));
         let dt =
             imesh_quad::RegionTriangulation::new(&c.simplified.graph, &DensityOptions::default())
                 .unwrap();
@@ -326,7 +313,7 @@ fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
 
 #[test]
 fn bad_options_are_typed_errors() {
-    let c = curves(&fixture("stardist-mask2d_labels.png"));
+    let c = curves(&support::fixture("stardist-mask2d_labels.png"));
     let curves: Vec<_> = c.fits.fits.iter().map(|f| f.curve).collect();
     for level in [0, 9] {
         let options = QuadOptions {

@@ -9,6 +9,20 @@ use imesh_curves::{CurveGraph, GraphEdge};
 use imesh_geom::Point;
 use imesh_segment::{SampleOptions, SegmentedMesh, OUTSIDE};
 
+/// The label grid of fixture `name` (under `fixtures/images/`): a label map for the `*labels*`
+/// images, three-level Otsu of the luminance otherwise.
+pub fn fixture(name: &str) -> LabelGrid {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name);
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    if name.contains("labels") {
+        return imesh_classify::label_map(&image, 256).unwrap();
+    }
+    let grey = imesh_classify::luminance(&image);
+    imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 3))
+}
+
 /// A label grid from raw labels (regions named after their index).
 pub fn grid(width: u32, height: u32, labels: Vec<u32>) -> LabelGrid {
     let count = labels.iter().max().map_or(1, |&m| m + 1);
