@@ -48,7 +48,7 @@ pub enum ClassifyError {
         limit: u64,
     },
     /// A label map has more distinct values than allowed.
-    #[error("the image has more than {limit} distinct values, too many for a label map: classify it instead (e.g. --classify otsu:3 or kmeans:4), or raise the label limit")]
+    #[error("the image has more than {limit} distinct values, too many for a label map: classify it instead (e.g. --classify otsu:3 or kmeans:4), or raise the label limit (--max-labels)")]
     TooManyLabels {
         /// The limit.
         limit: usize,

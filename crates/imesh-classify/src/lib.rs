@@ -39,7 +39,7 @@ pub use error::ClassifyError;
 pub use grid::{LabelGrid, Region};
 pub use kmeans::kmeans;
 pub use labels::{label_map, looks_like_label_map};
-pub use load::{load_image, DEFAULT_MAX_PIXELS};
+pub use load::{decode_image, load_image, DEFAULT_MAX_PIXELS};
 pub use spec::Classifier;
 pub use texture::{SampleLabel, TextureClassifier, TextureSamples};
 pub use threshold::{luminance, multi_otsu_levels, threshold};
@@ -47,13 +47,19 @@ pub use threshold::{luminance, multi_otsu_levels, threshold};
 /// Options shared by the classifiers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClassifyOptions {
-    /// Most distinct values a label map may have (default 256).
+    /// Most distinct values a label map may have (default [`DEFAULT_MAX_LABELS`]).
     pub max_labels: usize,
 }
 
+/// Default [`ClassifyOptions::max_labels`]: 65 536, every value of a 16-bit label map (instance
+/// segmentations often hold thousands of labels).
+pub const DEFAULT_MAX_LABELS: usize = 1 << 16;
+
 impl Default for ClassifyOptions {
     fn default() -> Self {
-        Self { max_labels: 256 }
+        Self {
+            max_labels: DEFAULT_MAX_LABELS,
+        }
     }
 }
 

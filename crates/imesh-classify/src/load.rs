@@ -1,8 +1,9 @@
 //! Image loading with limits.
 
+use std::io::Cursor;
 use std::path::Path;
 
-use image::{DynamicImage, ImageReader, Limits};
+use image::{DynamicImage, ImageFormat, ImageReader, Limits};
 
 use crate::ClassifyError;
 
@@ -21,6 +22,37 @@ pub const DEFAULT_MAX_PIXELS: u64 = 1 << 28;
 /// # Ok::<(), imesh_classify::ClassifyError>(())
 /// ```
 pub fn load_image(path: &Path, max_pixels: u64) -> Result<DynamicImage, ClassifyError> {
+    let bytes = std::fs::read(path).map_err(|source| ClassifyError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode(&bytes, path, max_pixels)
+}
+
+/// Decodes an image held in memory, as [`load_image`] does a file (the format is guessed from
+/// the bytes); errors name the image `<memory>`.
+///
+/// # Errors
+/// [`ClassifyError::Decode`], [`ClassifyError::EmptyImage`], [`ClassifyError::TooLarge`].
+///
+/// ```
+/// let mut png = Vec::new();
+/// image::GrayImage::new(3, 2)
+///     .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+///     .unwrap();
+/// let image = imesh_classify::decode_image(&png, 100)?;
+/// assert_eq!((image.width(), image.height()), (3, 2));
+/// assert!(imesh_classify::decode_image(&png, 5).is_err()); // 6 pixels > 5
+/// assert!(imesh_classify::decode_image(b"not an image", 100).is_err());
+/// # Ok::<(), imesh_classify::ClassifyError>(())
+/// ```
+pub fn decode_image(bytes: &[u8], max_pixels: u64) -> Result<DynamicImage, ClassifyError> {
+    decode(bytes, Path::new("<memory>"), max_pixels)
+}
+
+/// Reads the header first, so that an image over the limit is refused before any pixel is
+/// decoded, then decodes with an allocation limit in case the header lied.
+fn decode(bytes: &[u8], path: &Path, max_pixels: u64) -> Result<DynamicImage, ClassifyError> {
     let io = |source| ClassifyError::Io {
         path: path.to_path_buf(),
         source,
@@ -29,17 +61,22 @@ pub fn load_image(path: &Path, max_pixels: u64) -> Result<DynamicImage, Classify
         path: path.to_path_buf(),
         reason: e.to_string(),
     };
-    let (width, height) = ImageReader::open(path)
-        .map_err(io)?
-        .with_guessed_format()
-        .map_err(io)?
-        .into_dimensions()
-        .map_err(decode)?;
+    // The bytes name the format; the file's extension only when they do not (e.g. TGA).
+    let reader = || {
+        ImageReader::new(Cursor::new(bytes))
+            .with_guessed_format()
+            .map(|mut r| {
+                if r.format().is_none() {
+                    if let Ok(format) = ImageFormat::from_path(path) {
+                        r.set_format(format);
+                    }
+                }
+                r
+            })
+    };
+    let (width, height) = reader().map_err(io)?.into_dimensions().map_err(decode)?;
     check_size(path, width, height, max_pixels)?;
-    let mut reader = ImageReader::open(path)
-        .map_err(io)?
-        .with_guessed_format()
-        .map_err(io)?;
+    let mut reader = reader().map_err(io)?;
     let mut limits = Limits::default();
     // 16 bytes per pixel covers RGBA at 32-bit float, the widest layout decoded here.
     limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 20));

@@ -42,12 +42,31 @@ pub use triangulation::{
     EXTERIOR,
 };
 
+/// The largest coordinate magnitude accepted, 2^100: orientation and in-circle tests multiply
+/// up to four coordinate differences, and past this their exact expansions could overflow.
+pub const MAX_COORDINATE: f64 = 1_267_650_600_228_229_401_496_703_205_376.0;
+
+/// The smallest non-zero coordinate magnitude accepted, 2^-100: two such coordinates differ by at
+/// least 2^-152, and a product of four such differences (2^-608) with its rounding error stays
+/// far above the smallest normal `f64`, so exact expansions never underflow.
+pub const MIN_COORDINATE: f64 = 1.0 / MAX_COORDINATE;
+
 /// Errors of the geometry kernel.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum GeomError {
     /// A point has a NaN or infinite coordinate.
     #[error("point {index} has a non-finite coordinate ({x}, {y}): give finite coordinates")]
     NonFinitePoint {
+        /// Index of the point in the input.
+        index: usize,
+        /// Its x coordinate.
+        x: f64,
+        /// Its y coordinate.
+        y: f64,
+    },
+    /// A coordinate too large or too small (but not 0) for the exact predicates.
+    #[error("point {index} ({x}, {y}) is out of range: coordinates must be 0 or between {} and {} in magnitude (2^-100 and 2^100, where exact predicates can neither overflow nor underflow): scale the input", MIN_COORDINATE, MAX_COORDINATE)]
+    OutOfRange {
         /// Index of the point in the input.
         index: usize,
         /// Its x coordinate.

@@ -1,7 +1,7 @@
 //! Constrained and conforming Delaunay triangulations, and region labels.
 
 use imesh_geom::predicates::incircle;
-use imesh_geom::{GeomError, Point, Triangulation, VertexId, EXTERIOR};
+use imesh_geom::{GeomError, Point, RefineOptions, SegmentId, Triangulation, VertexId, EXTERIOR};
 use proptest::prelude::*;
 
 mod common;
@@ -226,4 +226,51 @@ fn a_refused_segment_leaves_nothing_behind() {
     assert_eq!(t.constrained_edges().count(), before);
     assert_eq!(t.num_segments(), 1);
     t.check().unwrap();
+}
+
+/// A segment given twice (either way round, either mode) is one segment: refinement that splits
+/// it keeps one chain up to date. Twice-given segments left a stale second chain before
+/// (found by `cargo fuzz run refine`; fuzz/regressions/refine).
+#[test]
+fn a_segment_given_twice_is_one_segment() {
+    let pts = [
+        Point::new(0.0, 31.0),
+        Point::new(4.0, 1.0),
+        Point::new(16.0, 29.0),
+    ];
+    for conforming in [false, true] {
+        let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+        let insert = |t: &mut Triangulation, a: usize, b: usize| {
+            if conforming {
+                t.insert_segment_conforming(v[a], v[b]).map(|_| ()).unwrap();
+            } else {
+                t.insert_segment(v[a], v[b]).unwrap();
+            }
+        };
+        insert(&mut t, 0, 1);
+        insert(&mut t, 1, 0);
+        insert(&mut t, 0, 1);
+        insert(&mut t, 1, 2);
+        insert(&mut t, 2, 0);
+        assert_eq!(t.num_segments(), 3, "conforming {conforming}");
+        if !conforming {
+            assert_eq!(t.insert_segment(v[1], v[0]).unwrap(), SegmentId(0));
+        }
+        t.label_regions(&[(Point::new(6.0, 20.0), 1)]);
+        t.refine(&RefineOptions {
+            min_angle_deg: 30.0,
+            max_steiner: 500,
+            max_area: Some(4.0),
+        })
+        .unwrap();
+        t.check().unwrap();
+        for s in 0..t.num_segments() {
+            let chain = t.segment_vertices(SegmentId(s as u32));
+            assert!(chain.len() > 2, "segment {s} was split");
+            for w in chain.windows(2) {
+                let e = t.find_edge(w[0], w[1]).expect("every piece is an edge");
+                assert_eq!(t.segment_of(e), Some(SegmentId(s as u32)));
+            }
+        }
+    }
 }

@@ -389,3 +389,51 @@ proptest! {
         prop_assert_eq!(bulk.num_vertices(), t.num_vertices());
     }
 }
+
+/// Coordinates where exact predicates would overflow (hanging the insertion at 1e200, breaking
+/// orientation at 1e100) or underflow (1e-150) are refused with a typed error; the bounds
+/// themselves and 0 are accepted. Found while writing the fuzz harness (fuzz/regressions/delaunay).
+#[test]
+fn coordinates_out_of_the_exact_range_are_refused() {
+    let lattice = |scale: f64| -> Vec<Point> {
+        (0..50)
+            .map(|i| {
+                Point::new(
+                    f64::from((i * 7) % 13) * scale,
+                    f64::from((i * 5) % 11) * scale,
+                )
+            })
+            .collect()
+    };
+    for scale in [1e200, 1e100, 1e-150, 1e-300] {
+        assert!(
+            matches!(
+                Triangulation::from_points(&lattice(scale)),
+                Err(GeomError::OutOfRange { .. })
+            ),
+            "scale {scale}"
+        );
+        let mut t = Triangulation::new();
+        let refused = lattice(scale)
+            .into_iter()
+            .filter(|&p| matches!(t.insert(p), Err(GeomError::OutOfRange { .. })))
+            .count();
+        assert!(refused > 0, "scale {scale}");
+        t.check().unwrap();
+    }
+    for scale in [1e25, 1e-25] {
+        let (t, _) = Triangulation::from_points(&lattice(scale)).unwrap();
+        t.check().unwrap();
+    }
+    let edge = [
+        Point::new(0.0, 0.0),
+        Point::new(imesh_geom::MAX_COORDINATE, 0.0),
+        Point::new(0.0, -imesh_geom::MAX_COORDINATE),
+        Point::new(imesh_geom::MIN_COORDINATE, imesh_geom::MIN_COORDINATE),
+    ];
+    let (t, _) = Triangulation::from_points(&edge).unwrap();
+    t.check().unwrap();
+    assert_eq!(t.num_triangles(), 2);
+    let err = Triangulation::from_points(&[Point::new(1e31, 0.0)]).unwrap_err();
+    assert!(err.to_string().contains("scale the input"), "{err}");
+}

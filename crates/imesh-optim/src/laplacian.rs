@@ -1,9 +1,9 @@
 //! The Laplacian baseline: each free quad vertex moves to the mean of its edge neighbours,
-//! Gauss–Seidel style, a move being kept only when the vertex's quads stay valid.
+//! Gauss–Seidel style, a move being kept only when the vertex's quads stay feasible (valid, and
+//! above the same floors as every mode), so that it never lowers the worst quality either.
 
 use imesh_geom::Point;
 
-use crate::energy::is_valid;
 use crate::variables::Variables;
 use crate::Setup;
 
@@ -46,7 +46,7 @@ pub(crate) fn smooth(variables: &Variables, vertices: &mut [Point], setup: &Setu
             vertices[v] = target;
             let valid = variables.quads.row(i).iter().all(|&q| {
                 let p = setup.quads[q as usize].map(|u| vertices[u as usize]);
-                is_valid(&p)
+                setup.term(q as usize, &p).is_some()
             });
             if valid {
                 largest = largest.max(old.distance_squared(target).sqrt());

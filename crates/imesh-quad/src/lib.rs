@@ -78,6 +78,14 @@ pub enum QuadError {
     /// From the geometry kernel (a bad angle, or a G' that is not planar).
     #[error(transparent)]
     Geometry(#[from] GeomError),
+    /// The templates would make more quads than allowed.
+    #[error("the mesh would have {quads} quads, over the limit of {limit}: raise the limit, or give a larger element size, a larger curve tolerance or a lower template level")]
+    TooManyQuads {
+        /// Quads the templates would make.
+        quads: u64,
+        /// The limit.
+        limit: u64,
+    },
 }
 
 /// Options of [`remesh`].
@@ -89,6 +97,9 @@ pub struct QuadOptions {
     pub pairing: Pairing,
     /// Template level k (1–8): each triangle gives 3k² quads, each quad 4k².
     pub level: u32,
+    /// Most quads the templates may make: checked once the pairing is known, before any
+    /// template is built (default: no limit).
+    pub max_quads: u64,
 }
 
 impl Default for QuadOptions {
@@ -97,6 +108,7 @@ impl Default for QuadOptions {
             density: DensityOptions::default(),
             pairing: Pairing::Greedy,
             level: 1,
+            max_quads: u64::MAX,
         }
     }
 }
@@ -124,7 +136,7 @@ pub struct Remesh {
 /// `curves` (one per edge of `g`, e.g. from [`imesh_curves::fit_edges`]).
 ///
 /// # Errors
-/// [`QuadError::BadLevel`], [`QuadError::CurveCount`], and those of
+/// [`QuadError::BadLevel`], [`QuadError::CurveCount`], [`QuadError::TooManyQuads`], and those of
 /// [`RegionTriangulation::new`].
 pub fn remesh(
     g: &CurveGraph,
@@ -144,6 +156,13 @@ pub fn remesh(
     }
     let dt = RegionTriangulation::new(g, &options.density)?;
     let elements = ElementMesh::pair(&dt.triangulation, options.pairing);
+    let quads = elements.quad_count(options.level);
+    if quads > options.max_quads {
+        return Err(QuadError::TooManyQuads {
+            quads,
+            limit: options.max_quads,
+        });
+    }
     let mut net = ControlNet::straight(&dt.triangulation, &elements);
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();

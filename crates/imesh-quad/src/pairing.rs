@@ -88,6 +88,23 @@ impl ElementMesh {
         self.edge_of_half[h.index()]
     }
 
+    /// The quads templates of level `level` make of these elements: 3k² per triangle, 4k² per
+    /// quad.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// use imesh_quad::{ElementMesh, Pairing};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(3.0, 0.0), Point::new(3.0, 2.0), Point::new(0.0, 2.0)];
+    /// let (t, _) = Triangulation::from_points(&pts).unwrap();
+    /// assert_eq!(ElementMesh::pair(&t, Pairing::Greedy).quad_count(2), 16);
+    /// ```
+    pub fn quad_count(&self, level: u32) -> u64 {
+        let k2 = u64::from(level) * u64::from(level);
+        let triangles = self.unpaired as u64;
+        let quads = self.elements.len() as u64 - triangles;
+        3 * k2 * triangles + 4 * k2 * quads
+    }
+
     /// The number of sides of element `element` (3 or 4).
     pub fn side_count(&self, element: usize) -> usize {
         self.elements[element].corners().len()
@@ -192,6 +209,11 @@ fn pair_up(partner: &mut [u32], f: TriangleId, n: TriangleId) {
     partner[n.index()] = f.index() as u32;
 }
 
+/// The greedy pairing's margin on "strictly convex": no corner within about 0.6° of flat
+/// (sine 0.01). A corner at 179.99° is convex in exact arithmetic, but the level-k template's
+/// corner quad there is so flat that the rounding of its points inverts it.
+const MIN_GREEDY_CORNER: f64 = 0.01;
+
 /// The paper's triquad. A sort stands in for the max-heap: the keys never change.
 fn greedy(t: &Triangulation) -> Vec<u32> {
     let mut candidates: Vec<(f64, HalfEdgeId)> = t
@@ -216,7 +238,7 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
             continue;
         }
         let Some(q) = quad_across(t, h) else { continue };
-        if !strictly_convex(&q) {
+        if !strictly_convex(&q) || worst_corner(&q) < MIN_GREEDY_CORNER {
             continue;
         }
         pair_up(&mut partner, f, n);

@@ -212,8 +212,16 @@ pub fn basis(quad: bool, uv: [f64; 2]) -> [f64; 16] {
         }
     } else {
         let (l1, l2) = (uv[0], uv[1]);
+        // On the side l1 + l2 = 1 the first weight must be exactly 0, or the patch's inner and
+        // other-side control points would pull the side's points (a border vertex off the
+        // border by 1e-17). Template coordinates are multiples of 1 / (6k²) ≥ 1 / 384, so a
+        // remainder below 1e-12 is rounding.
+        let l0 = match 1.0 - l1 - l2 {
+            r if r.abs() < 1e-12 => 0.0,
+            r => r,
+        };
         let powers = |x: f64| [1.0, x, x * x, x * x * x];
-        let (p0, p1, p2) = (powers(1.0 - l1 - l2), powers(l1), powers(l2));
+        let (p0, p1, p2) = (powers(l0), powers(l1), powers(l2));
         for (slot, &(a, b)) in TRIANGLE_SLOTS.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
             w[slot] = TRIANGLE_COEFFICIENTS[slot] * p0[3 - a - b] * p1[a] * p2[b];

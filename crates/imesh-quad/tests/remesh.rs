@@ -350,3 +350,26 @@ fn bad_options_are_typed_errors() {
         Err(QuadError::Geometry(_))
     ));
 }
+
+/// On the side `u + v = 1` of the canonical triangle, only the side's four control points weigh
+/// anything, exactly: a non-zero rounding weight (1e-17) on an inner point let the optimiser move
+/// a border vertex off the border at level 3 (fuzz/regressions/pipeline).
+#[test]
+fn a_triangle_side_depends_on_its_own_control_points_only() {
+    for k in 1..=8 {
+        let t = imesh_quad::Template::triangle(k);
+        let n = f64::from(6 * k * k);
+        for (uv, w) in t.coords.iter().zip(&t.weights) {
+            if ((uv[0] + uv[1]) * n).round() != n {
+                continue;
+            }
+            for (slot, &(a, b)) in imesh_quad::TRIANGLE_SLOTS.iter().enumerate() {
+                if a + b < 3 {
+                    assert_eq!(w[slot], 0.0, "level {k}, point {uv:?}, slot {slot}");
+                }
+            }
+            let sum: f64 = w.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-14, "level {k}: weights sum to {sum}");
+        }
+    }
+}

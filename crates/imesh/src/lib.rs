@@ -177,7 +177,16 @@ pub struct MeshOptions {
     pub pixel_size: [f64; 2],
     /// Largest image accepted, in pixels.
     pub max_pixels: u64,
+    /// Most labels a label map may have.
+    pub max_labels: usize,
+    /// Most elements the mesh may have: checked up front against a lower bound (with
+    /// `max_size`), caps the refinement, and checked exactly before the templates are built.
+    pub max_elements: u64,
 }
+
+/// Default [`MeshOptions::max_elements`]: five million elements (about 1.5 GB at the peak of a
+/// quad run).
+pub const DEFAULT_MAX_ELEMENTS: u64 = 5_000_000;
 
 impl Default for MeshOptions {
     fn default() -> Self {
@@ -196,6 +205,8 @@ impl Default for MeshOptions {
             global_iterations: OptimOptions::default().global_iterations,
             pixel_size: [1.0, 1.0],
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
+            max_labels: imesh_classify::DEFAULT_MAX_LABELS,
+            max_elements: DEFAULT_MAX_ELEMENTS,
         }
     }
 }
@@ -221,6 +232,9 @@ pub enum PipelineError {
     /// The optimiser refused its input.
     #[error(transparent)]
     Optimise(#[from] imesh_optim::OptimError),
+    /// The mesh would exceed a resource limit (`max_elements`).
+    #[error("{0}")]
+    Limit(String),
     /// The mesh broke an invariant (a bug: please report it with the image).
     #[error("the mesh is invalid ({0}); please report this with the image")]
     Invalid(String),
@@ -638,7 +652,13 @@ impl Pipeline {
         self.check_options()?;
         let start = Instant::now();
         let classifier = Classifier::from_str(&o.classify)?;
-        let grid = classify(image, &classifier, &ClassifyOptions::default())?;
+        let grid = classify(
+            image,
+            &classifier,
+            &ClassifyOptions {
+                max_labels: o.max_labels,
+            },
+        )?;
         let t_classify = start.elapsed().as_secs_f64();
         self.run_grid(&grid, t_classify)
     }
@@ -654,6 +674,7 @@ impl Pipeline {
     ) -> Result<PipelineResult, PipelineError> {
         let o = &self.options;
         self.check_options()?;
+        self.check_size(grid.width(), grid.height())?;
         let start = Instant::now();
         self.stage(Stage::Sample);
         let mut segmented = SegmentedMesh::from_grid(
@@ -829,9 +850,16 @@ impl Pipeline {
         self.stage(Stage::Refine);
         let refined = segmented.refine(&RefineOptions {
             min_angle_deg: o.min_angle.unwrap_or(imesh_segment::DEFAULT_MIN_ANGLE),
-            max_steiner: o.max_steiner.unwrap_or(usize::MAX),
+            max_steiner: self.refinement_cap(),
             max_area: o.max_size.map(equilateral_area),
         })?;
+        let triangles = segmented.triangulation.num_triangles() as u64;
+        if triangles > o.max_elements
+            || (refined.stopped == StopReason::CapReached
+                && o.max_steiner.is_none_or(|n| n > self.refinement_cap()))
+        {
+            return Err(self.too_many_elements(triangles.max(o.max_elements + 1), "triangles"));
+        }
         seconds.refine = start.elapsed().as_secs_f64();
         counts.refinement_points = refined.inserted;
         counts.triangles_below_min_angle = if refined.stopped == StopReason::Done {
@@ -898,7 +926,7 @@ impl Pipeline {
                     min_angle_deg: o
                         .min_angle
                         .unwrap_or(DensityOptions::default().min_angle_deg),
-                    max_steiner: o.max_steiner.unwrap_or(usize::MAX),
+                    max_steiner: self.refinement_cap(),
                     max_size: o.max_size,
                 },
                 pairing: match o.pairing {
@@ -906,8 +934,15 @@ impl Pipeline {
                     PairingMethod::Matching => Pairing::Matching,
                 },
                 level: o.template_level,
+                max_quads: o.max_elements,
             },
-        )?;
+        )
+        .map_err(|e| match e {
+            imesh_quad::QuadError::TooManyQuads { quads, .. } => {
+                self.too_many_elements(quads, "quads")
+            }
+            e => PipelineError::Quads(e),
+        })?;
         seconds.quads = start.elapsed().as_secs_f64() - seconds.curves;
         counts.simplified_edges = simplified.graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
@@ -1014,6 +1049,43 @@ impl Pipeline {
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
         let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
         Ok((vertices, elements, r.mesh.labels))
+    }
+
+    /// The refinement's point cap: the user's, and never more than the element limit (every
+    /// inserted point adds about two triangles).
+    fn refinement_cap(&self) -> usize {
+        let o = &self.options;
+        let limit = usize::try_from(o.max_elements).unwrap_or(usize::MAX);
+        o.max_steiner.unwrap_or(usize::MAX).min(limit)
+    }
+
+    fn too_many_elements(&self, at_least: u64, kind: &str) -> PipelineError {
+        PipelineError::Limit(format!(
+            "the mesh would have at least {at_least} {kind}, over the limit of {} elements: \
+             raise --max-elements, or give a larger --max-size, --tolerance or --te, or a lower \
+             --template-level",
+            self.options.max_elements
+        ))
+    }
+
+    /// Refuses, before any work, a run whose element count is sure to exceed the limit: with a
+    /// largest size, DT' (or the triangle mesh) needs at least the domain's area over the
+    /// largest triangle's, and pairing at best halves that before the templates multiply it.
+    fn check_size(&self, width: u32, height: u32) -> Result<(), PipelineError> {
+        let o = &self.options;
+        let Some(size) = o.max_size else {
+            return Ok(());
+        };
+        let triangles = (f64::from(width) * f64::from(height) / equilateral_area(size)).floor();
+        let k2 = f64::from(o.template_level).powi(2);
+        let (at_least, kind) = match o.elements {
+            Elements::Tri => (triangles, "triangles"),
+            Elements::Quad => (2.0 * k2 * triangles, "quads"),
+        };
+        if at_least > o.max_elements as f64 {
+            return Err(self.too_many_elements(at_least.min(u64::MAX as f64) as u64, kind));
+        }
+        Ok(())
     }
 
     fn check_options(&self) -> Result<(), PipelineError> {

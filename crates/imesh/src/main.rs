@@ -147,6 +147,16 @@ struct MeshFlags {
     /// Physical size of a pixel: SX or SX,SY.
     #[arg(long, value_parser = parse_pixel_size)]
     pixel_size: Option<[f64; 2]>,
+    /// Largest image accepted, in pixels [default: 268435456, a 16384 × 16384 image].
+    #[arg(long)]
+    max_pixels: Option<u64>,
+    /// Most labels a label map may have [default: 65536].
+    #[arg(long)]
+    max_labels: Option<usize>,
+    /// Most elements the mesh may have; a run that would make more stops early with an error
+    /// [default: 5000000].
+    #[arg(long)]
+    max_elements: Option<u64>,
 }
 
 #[derive(Args)]
@@ -248,6 +258,15 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(p) = args.pixel_size {
         o.pixel_size = p;
+    }
+    if let Some(n) = args.max_pixels {
+        o.max_pixels = n;
+    }
+    if let Some(n) = args.max_labels {
+        o.max_labels = n;
+    }
+    if let Some(n) = args.max_elements {
+        o.max_elements = n;
     }
     Ok(o)
 }

@@ -289,7 +289,7 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
     let image = image.to_str().unwrap();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: &[(&[&str], &str)] = &[
         (&["mesh", image, "--frobnicate"], "unexpected argument"),
         (
             &["mesh", image, "--classify", "bogus:3"],
@@ -313,8 +313,38 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
             &["mesh", image, "--elements", "tri", "--histogram", "h.png"],
             "drop --elements tri",
         ),
+        // Resource limits: each refused with what to change, before anything is written.
+        (
+            &["mesh", image, "-o", "m.msh", "--max-elements", "1000"],
+            "--max-elements",
+        ),
+        (
+            &[
+                "mesh",
+                image,
+                "-o",
+                "m.msh",
+                "--elements",
+                "tri",
+                "--max-elements",
+                "500",
+            ],
+            "--max-elements",
+        ),
+        (
+            &["mesh", image, "-o", "m.msh", "--max-size", "0.05"],
+            "over the limit of 5000000 elements",
+        ),
+        (
+            &["mesh", image, "-o", "m.msh", "--max-pixels", "1000"],
+            "1000",
+        ),
+        (
+            &["mesh", image, "--classify", "labels", "--max-labels", "10"],
+            "--max-labels",
+        ),
     ];
-    for (args, hint) in cases {
+    for &(args, hint) in cases {
         let out = imesh(args, dir.path());
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
@@ -333,6 +363,58 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         vec![std::ffi::OsString::from("notes.png")],
         "no output was left behind"
     );
+}
+
+/// The same input and options give byte-identical files on 1 and 2 threads (every parallel stage
+/// is ordered by index, never by completion).
+#[test]
+fn outputs_are_byte_identical_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    for (fixture_name, extra) in [
+        ("skimage-coins.png", &[][..]),
+        ("stardist-mask2d_labels.png", &["--template-level", "2"][..]),
+        (
+            "pyvista-channels_z050_labels.png",
+            &["--elements", "tri"][..],
+        ),
+    ] {
+        let image = fixture(fixture_name);
+        let mut outputs = Vec::new();
+        for threads in ["1", "2"] {
+            let stem = format!("{fixture_name}-{threads}");
+            let (msh, vtu, svg) = (
+                format!("{stem}.msh"),
+                format!("{stem}.vtu"),
+                format!("{stem}.svg"),
+            );
+            for (output, picture) in [(&msh, Some(&svg)), (&vtu, None)] {
+                let mut args = vec!["mesh", image.to_str().unwrap(), "-o", output.as_str()];
+                if let Some(svg) = picture {
+                    args.extend(["--svg", svg.as_str()]);
+                }
+                args.extend(extra);
+                let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
+                    .args(&args)
+                    .env("RAYON_NUM_THREADS", threads)
+                    .current_dir(dir.path())
+                    .output()
+                    .unwrap();
+                assert!(
+                    out.status.success(),
+                    "{args:?}: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+            }
+            outputs.push([msh, vtu, svg].map(|f| std::fs::read(dir.path().join(f)).unwrap()));
+        }
+        for (k, kind) in ["msh", "vtu", "svg"].iter().enumerate() {
+            assert!(outputs[0][k].len() > 1000, "{fixture_name} {kind}");
+            assert!(
+                outputs[0][k] == outputs[1][k],
+                "{fixture_name}: the .{kind} differs between 1 and 2 threads"
+            );
+        }
+    }
 }
 
 #[test]

@@ -194,6 +194,7 @@ impl Triangulation {
 
     /// Inserts the segment between existing vertices `a` and `b` as a constraint (constrained
     /// Delaunay). A vertex lying on the segment splits it: each piece is its own chain of edges.
+    /// A segment equal to an earlier one (either way round) is that segment: nothing changes.
     ///
     /// # Errors
     /// [`GeomError::CrossingSegments`] when it crosses or overlaps an earlier segment (nothing is
@@ -211,11 +212,14 @@ impl Triangulation {
     /// ```
     pub fn insert_segment(&mut self, a: VertexId, b: VertexId) -> Result<SegmentId, GeomError> {
         self.validate_segment(a, b)?;
+        if let Some(s) = self.existing_segment(a.0, b.0) {
+            return Ok(s);
+        }
         self.ensure_constraint_storage();
         // Trace the whole segment first, so that a crossing leaves the triangulation unchanged.
         let mut from = a.0;
         while from != b.0 {
-            from = match self.trace_piece(from, b.0)? {
+            from = match self.trace_piece(from, b.0, false)? {
                 Piece::Edge(_, c) => c,
                 Piece::Crossing { end, .. } => end,
             };
@@ -228,6 +232,23 @@ impl Triangulation {
             from = self.constrain_piece(from, b.0, id)?;
         }
         Ok(SegmentId(id))
+    }
+
+    /// The segment with ends `a` and `b` (either way round), if one was inserted: a piece of it
+    /// leaves `a` (found through `a`'s edges, not along the line: the split points of a
+    /// conforming segment are rounded a hair off it).
+    fn existing_segment(&self, a: u32, b: u32) -> Option<SegmentId> {
+        if self.segment.is_empty() {
+            return None;
+        }
+        self.star(a)
+            .map(|h| self.segment[h as usize])
+            .find(|&s| {
+                self.segments
+                    .get(s as usize)
+                    .is_some_and(|&ends| ends == [a, b] || ends == [b, a])
+            })
+            .map(SegmentId)
     }
 
     fn validate_segment(&self, a: VertexId, b: VertexId) -> Result<(), GeomError> {
@@ -253,7 +274,11 @@ impl Triangulation {
 
     /// Traces the piece of a segment from `a` towards `b` up to the first vertex on it, without
     /// changing anything: the edge it runs along, or the edges it crosses.
-    fn trace_piece(&self, a: u32, b: u32) -> Result<Piece, GeomError> {
+    ///
+    /// A piece that runs along another segment is an overlap ([`GeomError::CrossingSegments`]);
+    /// so is crossing one, unless `may_cross` (a conforming segment splits the segments it
+    /// crosses).
+    fn trace_piece(&self, a: u32, b: u32, may_cross: bool) -> Result<Piece, GeomError> {
         let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
         let crossing = match self.first_step(a, b) {
             Some(Step::AlongEdge(h, c)) => {
@@ -280,7 +305,11 @@ impl Triangulation {
         let mut crossed: Vec<[u32; 2]> = Vec::new();
         let mut e = crossing;
         loop {
-            if let Some(&s) = self.segment.get(e as usize).filter(|&&s| s != NONE) {
+            if let Some(&s) = self
+                .segment
+                .get(e as usize)
+                .filter(|&&s| s != NONE && !may_cross)
+            {
                 return Err(GeomError::CrossingSegments {
                     new: [a, b],
                     existing: self.segments[s as usize],
@@ -312,7 +341,7 @@ impl Triangulation {
     /// segment; returns that vertex.
     fn constrain_piece(&mut self, a: u32, b: u32, id: u32) -> Result<u32, GeomError> {
         let pa = self.points[a as usize];
-        let (crossed, end) = match self.trace_piece(a, b)? {
+        let (crossed, end) = match self.trace_piece(a, b, false)? {
             Piece::Edge(h, c) => {
                 self.mark(h, id, a, c)?;
                 return Ok(c);
@@ -421,7 +450,8 @@ impl Triangulation {
     /// vertex, which is split where a circle centred there with a power-of-two radius crosses it
     /// (concentric shells: Ruppert's guard against endless splitting near small angles).
     ///
-    /// Returns the Steiner vertices created, in order from `a` to `b`.
+    /// Returns the Steiner vertices created, in order from `a` to `b` (none for a segment equal to
+    /// an earlier one, either way round: nothing changes).
     ///
     /// # Errors
     /// As [`insert_segment`](Self::insert_segment).
@@ -442,7 +472,18 @@ impl Triangulation {
         b: VertexId,
     ) -> Result<Vec<VertexId>, GeomError> {
         self.validate_segment(a, b)?;
+        if self.existing_segment(a.0, b.0).is_some() {
+            return Ok(Vec::new());
+        }
         self.ensure_constraint_storage();
+        // Trace the whole segment first, so that an overlap leaves the triangulation unchanged.
+        let mut from = a.0;
+        while from != b.0 {
+            from = match self.trace_piece(from, b.0, true)? {
+                Piece::Edge(_, c) => c,
+                Piece::Crossing { end, .. } => end,
+            };
+        }
         let id = self.segments.len() as u32;
         self.segments.push([a.0, b.0]);
         self.chains.push(vec![a.0, b.0]);

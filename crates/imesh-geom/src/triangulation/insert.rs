@@ -16,7 +16,7 @@ use std::sync::atomic::Ordering;
 
 use super::{next, HalfEdgeId, TriangleId, Triangulation, VertexId, EXTERIOR, GHOST, NONE};
 use crate::predicates::{incircle, orient2d, strictly_between};
-use crate::{GeomError, Point};
+use crate::{GeomError, Point, MAX_COORDINATE, MIN_COORDINATE};
 
 /// Where a point lies in a [`Triangulation`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -639,12 +639,19 @@ impl Triangulation {
 }
 
 fn validate(points: &[Point]) -> Result<(), GeomError> {
-    match points.iter().position(|p| !p.is_finite()) {
-        Some(index) => Err(GeomError::NonFinitePoint {
-            index,
-            x: points[index].x,
-            y: points[index].y,
-        }),
+    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+        let Point { x, y } = points[index];
+        return Err(GeomError::NonFinitePoint { index, x, y });
+    }
+    let in_range = |c: f64| c == 0.0 || (MIN_COORDINATE..=MAX_COORDINATE).contains(&c.abs());
+    match points
+        .iter()
+        .position(|p| !(in_range(p.x) && in_range(p.y)))
+    {
+        Some(index) => {
+            let Point { x, y } = points[index];
+            Err(GeomError::OutOfRange { index, x, y })
+        }
         None => Ok(()),
     }
 }

@@ -1,0 +1,118 @@
+//! Parameter sweeps (issue 11): over t_e, curve tolerance, smallest angle, largest size, template
+//! level, pairing, optimiser and element kind, on crops of every fixture's label grid, the same
+//! invariants hold for every combination: a valid mesh (conforming, no inverted element, exact
+//! area, one known label per element).
+
+mod support;
+
+use std::str::FromStr;
+use std::sync::OnceLock;
+
+use imesh::{Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline};
+use imesh_classify::{classify, Classifier, ClassifyOptions, LabelGrid};
+use proptest::prelude::*;
+
+/// Every fixture's label grid, as the default classifier sees it.
+fn grids() -> &'static [(String, LabelGrid)] {
+    static GRIDS: OnceLock<Vec<(String, LabelGrid)>> = OnceLock::new();
+    GRIDS.get_or_init(|| {
+        support::fixtures()
+            .into_iter()
+            .map(|path| {
+                let image =
+                    imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+                let grid = classify(
+                    &image,
+                    &Classifier::from_str("auto").unwrap(),
+                    &ClassifyOptions::default(),
+                )
+                .unwrap();
+                (
+                    path.file_name().unwrap().to_string_lossy().into_owned(),
+                    grid,
+                )
+            })
+            .collect()
+    })
+}
+
+/// The `w × h` crop of `grid` at `(x, y)` (fractions of the free range).
+fn crop(grid: &LabelGrid, fx: f64, fy: f64, w: u32, h: u32) -> LabelGrid {
+    let (w, h) = (w.min(grid.width()), h.min(grid.height()));
+    let x0 = (fx * f64::from(grid.width() - w)) as u32;
+    let y0 = (fy * f64::from(grid.height() - h)) as u32;
+    let labels = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .map(|(c, r)| grid.label(x0 + c, y0 + r))
+        .collect();
+    LabelGrid::new(w, h, labels, grid.regions().to_vec()).expect("a crop of a valid grid")
+}
+
+fn options() -> impl Strategy<Value = MeshOptions> {
+    (
+        prop::sample::select(vec![0.05, 0.1, 0.3, 0.6]),
+        0.0..15.0f64,
+        prop::option::of(10.0..33.0f64),
+        prop::option::of(2.0..24.0f64),
+        1u32..=3,
+        prop::sample::select(vec![PairingMethod::Matching, PairingMethod::Greedy]),
+        prop::sample::select(vec![
+            OptimizerMethod::Local,
+            OptimizerMethod::Global,
+            OptimizerMethod::Laplacian,
+            OptimizerMethod::Vertex,
+            OptimizerMethod::None,
+        ]),
+        prop::sample::select(vec![Elements::Quad, Elements::Quad, Elements::Tri]),
+    )
+        .prop_map(
+            |(te, tolerance, min_angle, max_size, level, pairing, optimizer, elements)| {
+                MeshOptions {
+                    te,
+                    tolerance,
+                    min_angle,
+                    max_size,
+                    template_level: level,
+                    pairing,
+                    optimizer,
+                    global_iterations: 2,
+                    elements,
+                    ..MeshOptions::default()
+                }
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn every_combination_gives_a_valid_mesh(
+        fixture in 0usize..10,
+        (fx, fy) in (0.0..1.0f64, 0.0..1.0f64),
+        (w, h) in (24u32..80, 24u32..80),
+        options in options(),
+    ) {
+        let all = grids();
+        prop_assert!(all.len() >= 10);
+        let (name, grid) = &all[fixture % all.len()];
+        let grid = crop(grid, fx, fy, w, h);
+        let result = Pipeline::new(options.clone())
+            .run_grid(&grid, 0.0)
+            .map_err(|e| TestCaseError::fail(format!("{name} {w}×{h}: {e} with {options:?}")))?;
+        let r = &result.report;
+        prop_assert!(r.validation.valid);
+        prop_assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "area {}", r.validation.area_ratio);
+        prop_assert!(r.quality.scaled_jacobian().min > 0.0, "an inverted element");
+        prop_assert_eq!(result.mesh.labels.len(), result.mesh.elements.len());
+        prop_assert!(result.mesh.labels.iter().all(|&l| (l as usize) < grid.num_labels()));
+        match options.elements {
+            Elements::Quad => prop_assert_eq!(r.counts.triangles, 0),
+            Elements::Tri => prop_assert_eq!(r.counts.quads, 0),
+        }
+        if let (Elements::Quad, Some(before)) = (options.elements, &r.quality_before_optimisation) {
+            // The optimiser never lowers the worst shape.
+            prop_assert!(r.quality.shape().min >= before.shape().min - 1e-12);
+        }
+    }
+}
