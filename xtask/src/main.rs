@@ -6,6 +6,7 @@
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask compare gmsh
 //! cargo xtask fixtures quality
+//! cargo xtask fuzz [TARGET ...] [--seconds N]
 //! ```
 
 mod alloc;
@@ -14,6 +15,7 @@ mod bench_optim;
 mod bench_refine;
 mod compare_gmsh;
 mod fixtures;
+mod fuzz;
 
 use std::process::ExitCode;
 
@@ -22,6 +24,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask compare gmsh
        cargo xtask fixtures quality
+       cargo xtask fuzz [TARGET ...] [--seconds N]
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
                    writes target/bench/delaunay.json
@@ -43,7 +46,13 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    writes target/bench/compare-gmsh.json
 
   fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
-                   vtkMeshQuality, installed from PyPI into target/venv-vtk";
+                   vtkMeshQuality, installed from PyPI into target/venv-vtk
+
+  fuzz             coverage-guided fuzzing (cargo-fuzz, libFuzzer, nightly) of the harnesses
+                   in fuzz/harness.rs: delaunay, refine, simplify, pipeline, decode (all when
+                   none is named), one after the other; inputs that break an invariant land in
+                   fuzz/artifacts/TARGET/ (replayed by `cargo test` once under fuzz/regressions/)
+    --seconds N    fuzzing time per target (default 600)";
 
 #[global_allocator]
 static ALLOCATOR: alloc::CountingAllocator = alloc::CountingAllocator;
@@ -68,13 +77,7 @@ fn run(args: &[String]) -> Result<(), String> {
             while let Some(&flag) = it.next() {
                 match flag {
                     "--quick" => options.quick = true,
-                    "--runs" => {
-                        let n = it.next().ok_or("--runs needs a number")?;
-                        options.runs =
-                            n.parse().ok().filter(|&r: &usize| r > 0).ok_or_else(|| {
-                                format!("--runs takes a positive integer, not '{n}'")
-                            })?;
-                    }
+                    "--runs" => options.runs = positive(flag, it.next())?,
                     other => return Err(format!("unknown option '{other}'")),
                 }
             }
@@ -83,11 +86,7 @@ fn run(args: &[String]) -> Result<(), String> {
         ["bench", "refine", rest @ ..] => {
             let runs = match rest {
                 [] => 3,
-                ["--runs", n] => n
-                    .parse()
-                    .ok()
-                    .filter(|&r: &usize| r > 0)
-                    .ok_or_else(|| format!("--runs takes a positive integer, not '{n}'"))?,
+                [flag @ "--runs", n] => positive(flag, Some(n))?,
                 _ => return Err(format!("unknown options '{}'", rest.join(" "))),
             };
             bench_refine::run(runs)
@@ -95,23 +94,46 @@ fn run(args: &[String]) -> Result<(), String> {
         ["bench", "optim", rest @ ..] => {
             let iterations = match rest {
                 [] => 10,
-                ["--global-iterations", n] => {
-                    n.parse().ok().filter(|&r: &u64| r > 0).ok_or_else(|| {
-                        format!("--global-iterations takes a positive integer, not '{n}'")
-                    })?
-                }
+                [flag @ "--global-iterations", n] => positive(flag, Some(n))?,
                 _ => return Err(format!("unknown options '{}'", rest.join(" "))),
             };
             bench_optim::run(iterations)
         }
         ["compare", "gmsh"] => compare_gmsh::run(),
         ["fixtures", "quality"] => fixtures::quality(),
+        ["fuzz", rest @ ..] => {
+            let mut options = fuzz::Options {
+                targets: Vec::new(),
+                seconds: 600,
+            };
+            let mut it = rest.iter();
+            while let Some(&word) = it.next() {
+                match word {
+                    "--seconds" => options.seconds = positive(word, it.next())?,
+                    target if !target.starts_with('-') => options.targets.push(target.into()),
+                    other => return Err(format!("unknown option '{other}'")),
+                }
+            }
+            fuzz::run(&options)
+        }
         [] | ["help"] | ["--help"] | ["-h"] => {
             println!("{USAGE}");
             Ok(())
         }
         _ => Err(format!("unknown command '{}'", words.join(" "))),
     }
+}
+
+/// The positive integer after option `flag`.
+fn positive<T: std::str::FromStr + Default + PartialOrd>(
+    flag: &str,
+    value: Option<&&str>,
+) -> Result<T, String> {
+    let n = value.ok_or_else(|| format!("{flag} needs a number"))?;
+    n.parse()
+        .ok()
+        .filter(|r| *r > T::default())
+        .ok_or_else(|| format!("{flag} takes a positive integer, not '{n}'"))
 }
 
 /// `target/bench/` of the workspace (created if needed).
