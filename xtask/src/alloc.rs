@@ -48,3 +48,15 @@ pub fn peak_during<T>(f: impl FnOnce() -> T) -> (T, usize) {
     let out = f();
     (out, PEAK.load(Ordering::Relaxed).saturating_sub(base))
 }
+
+/// Live heap bytes now.
+pub fn live() -> usize {
+    LIVE.load(Ordering::Relaxed)
+}
+
+/// The peak of live heap bytes since the last call (or since the start), then starts a new
+/// period at the current level: called at each stage boundary, it gives each stage's peak.
+pub fn take_peak() -> usize {
+    let live = LIVE.load(Ordering::Relaxed);
+    PEAK.swap(live, Ordering::Relaxed).max(live)
+}

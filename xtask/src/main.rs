@@ -4,6 +4,7 @@
 //! cargo xtask bench delaunay [--runs N] [--quick]
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
+//! cargo xtask bench pipeline [--scaling-max SIDE]
 //! cargo xtask compare gmsh
 //! cargo xtask fixtures quality
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -12,6 +13,7 @@
 mod alloc;
 mod bench_delaunay;
 mod bench_optim;
+mod bench_pipeline;
 mod bench_refine;
 mod compare_gmsh;
 mod fixtures;
@@ -22,6 +24,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
+       cargo xtask bench pipeline [--scaling-max SIDE]
        cargo xtask compare gmsh
        cargo xtask fixtures quality
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -39,6 +42,12 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    fixtures) through the whole pipeline: worst / mean quality and seconds;
                    writes target/bench/optim.json
     --global-iterations N   Powell iterations of the global mode (default 10)
+
+  bench pipeline   the whole run on every fixture as the paper's Table I (counts, seconds per
+                   stage, quality), one image at three densities (Figure 8 / Table II), and the
+                   camera fixture resized 256² … 4096² (seconds and peak heap per stage);
+                   writes target/bench/pipeline.md and pipeline.json
+    --scaling-max SIDE   largest side of the scaling series (default 4096)
 
   compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
                    same simplified boundaries of five fixtures at about the same quad count,
@@ -98,6 +107,14 @@ fn run(args: &[String]) -> Result<(), String> {
                 _ => return Err(format!("unknown options '{}'", rest.join(" "))),
             };
             bench_optim::run(iterations)
+        }
+        ["bench", "pipeline", rest @ ..] => {
+            let side = match rest {
+                [] => 4096,
+                [flag @ "--scaling-max", n] => positive(flag, Some(n))?,
+                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+            };
+            bench_pipeline::run(side)
         }
         ["compare", "gmsh"] => compare_gmsh::run(),
         ["fixtures", "quality"] => fixtures::quality(),

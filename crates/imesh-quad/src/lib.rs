@@ -130,6 +130,19 @@ pub struct Remesh {
     pub edge_curves: Vec<EdgeCurve>,
     /// What adaptation did.
     pub adaptation: AdaptReport,
+    /// Seconds spent in each step.
+    pub seconds: RemeshSeconds,
+}
+
+/// Seconds spent in each step of [`remesh`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RemeshSeconds {
+    /// DT': the conforming Delaunay triangulation of G' and its refinement.
+    pub triangulation: f64,
+    /// Pairing, the control net and the templates.
+    pub templates: f64,
+    /// Boundary adaptation.
+    pub adaptation: f64,
 }
 
 /// The whole quad stage: DT' of `g` (G'), pairing, patches, templates, and adaptation to
@@ -154,7 +167,9 @@ pub fn remesh(
             edges: g.edges().len(),
         });
     }
+    let clock = std::time::Instant::now();
     let dt = RegionTriangulation::new(g, &options.density)?;
+    let triangulation = clock.elapsed().as_secs_f64();
     let elements = ElementMesh::pair(&dt.triangulation, options.pairing);
     let quads = elements.quad_count(options.level);
     if quads > options.max_quads {
@@ -166,8 +181,15 @@ pub fn remesh(
     let mut net = ControlNet::straight(&dt.triangulation, &elements);
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();
+    let templates = clock.elapsed().as_secs_f64() - triangulation;
     let (adaptation, edge_curves) = adapt(&dt, g, curves, &elements, &mut net, &mut mesh);
+    let seconds = RemeshSeconds {
+        triangulation,
+        templates,
+        adaptation: clock.elapsed().as_secs_f64() - triangulation - templates,
+    };
     Ok(Remesh {
+        seconds,
         dt,
         elements,
         net,

@@ -251,8 +251,14 @@ pub struct StageSeconds {
     pub refine: f64,
     /// Curve simplification and fitting (quads).
     pub curves: f64,
-    /// DT', pairing, templates and adaptation (quads).
+    /// DT', pairing, templates and adaptation (quads): the sum of the next three.
     pub quads: f64,
+    /// DT': the conforming Delaunay triangulation of the simplified boundaries (quads).
+    pub dt: f64,
+    /// Pairing, the control net and the templates (quads).
+    pub pairing_templates: f64,
+    /// Boundary adaptation (quads).
+    pub adaptation: f64,
     /// Optimisation of the quads.
     pub optimise: f64,
     /// Invariant checks and quality measurement.
@@ -944,6 +950,9 @@ impl Pipeline {
             e => PipelineError::Quads(e),
         })?;
         seconds.quads = start.elapsed().as_secs_f64() - seconds.curves;
+        seconds.dt = r.seconds.triangulation;
+        seconds.pairing_templates = r.seconds.templates;
+        seconds.adaptation = r.seconds.adaptation;
         counts.simplified_edges = simplified.graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
         counts.refinement_points = r.dt.refinement.inserted;

@@ -1,0 +1,289 @@
+//! `cargo xtask bench pipeline`: the whole image → quad mesh run on every fixture, in the shape of
+//! the paper's Table I (counts, seconds per stage, quality), the paper's Figure 8 experiment (one
+//! image at three densities, its Table II), and the scaling of one image from 256² to 4096²
+//! (seconds and peak heap per stage). Writes Markdown and JSON under `target/bench/`.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use imesh::{MeshOptions, Pipeline, PipelineResult, Stage};
+use serde::Serialize;
+
+use crate::alloc;
+
+/// One run: counts, seconds per stage, peak heap per stage, quality.
+#[derive(Serialize)]
+struct Row {
+    name: String,
+    width: u32,
+    height: u32,
+    vertices: usize,
+    quads: usize,
+    seconds: Seconds,
+    /// Peak live heap bytes during each stage, by stage name.
+    peak_bytes: Vec<(String, usize)>,
+    shape_and_size: [f64; 3],
+    shape: [f64; 2],
+    scaled_jacobian: [f64; 2],
+    label_agreement: f64,
+    unpaired_share: f64,
+}
+
+#[derive(Serialize)]
+struct Seconds {
+    classify: f64,
+    sample: f64,
+    curves: f64,
+    dt: f64,
+    pairing_templates: f64,
+    adaptation: f64,
+    optimise: f64,
+    write: f64,
+    total: f64,
+}
+
+fn fixtures_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
+}
+
+/// Runs the pipeline on `image`, recording the heap peak of each stage, then writes the mesh
+/// as MSH 4.1 (timed: the paper's "write" column).
+fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Result<Row, String> {
+    let peaks: Arc<Mutex<Vec<(Stage, usize)>>> = Arc::new(Mutex::new(Vec::new()));
+    let log = Arc::clone(&peaks);
+    let base = alloc::live();
+    alloc::take_peak();
+    let clock = Instant::now();
+    let result: PipelineResult = Pipeline::new(options.clone())
+        .with_progress(move |stage| {
+            // The peak since the previous stage began belongs to that stage.
+            let peak = alloc::take_peak().saturating_sub(base);
+            if let Ok(mut log) = log.lock() {
+                log.push((stage, peak));
+            }
+        })
+        .run_image(image)
+        .map_err(|e| format!("{name}: {e}"))?;
+    let last_peak = alloc::take_peak().saturating_sub(base);
+    let dir = tempdir()?;
+    let path = dir.join(format!(
+        "{}.msh",
+        name.replace(|c: char| !c.is_alphanumeric(), "_")
+    ));
+    let write = Instant::now();
+    imesh_io::write_msh(&path, &result.mesh, &imesh_io::Frame::default())
+        .map_err(|e| format!("{name}: {e}"))?;
+    let write = write.elapsed().as_secs_f64();
+    let total = clock.elapsed().as_secs_f64();
+    let _ = std::fs::remove_file(&path);
+    let mut stages = peaks.lock().map_err(|_| "poisoned")?.clone();
+    // Stage k's peak was read when stage k + 1 began; the last one's at the end.
+    let mut peak_bytes = Vec::new();
+    for k in 0..stages.len() {
+        let peak = stages.get(k + 1).map_or(last_peak, |s| s.1);
+        peak_bytes.push((format!("{:?}", stages[k].0).to_lowercase(), peak));
+    }
+    stages.clear();
+    let r = &result.report;
+    let s = &r.seconds;
+    let q = &r.quality;
+    let sas = q.shape_and_size().ok_or("no quad quality")?;
+    Ok(Row {
+        name: name.to_string(),
+        width: r.counts.width,
+        height: r.counts.height,
+        vertices: r.counts.vertices,
+        quads: r.counts.quads,
+        seconds: Seconds {
+            classify: s.classify,
+            sample: s.sample,
+            curves: s.curves,
+            dt: s.dt,
+            pairing_templates: s.pairing_templates,
+            adaptation: s.adaptation,
+            optimise: s.optimise,
+            write,
+            total,
+        },
+        peak_bytes,
+        shape_and_size: [sas.min, sas.mean, sas.variance],
+        shape: [q.shape().min, q.shape().mean],
+        scaled_jacobian: [q.scaled_jacobian().min, q.scaled_jacobian().mean],
+        label_agreement: r.label_agreement,
+        unpaired_share: r.counts.unpaired_triangles as f64 / r.counts.dt_triangles.max(1) as f64,
+    })
+}
+
+fn tempdir() -> Result<PathBuf, String> {
+    let dir = crate::bench_dir()?.join("pipeline-meshes");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    Ok(dir)
+}
+
+const HEADER: &str = "| image | size | vertices | quads | classify | sample | curves | DT' | pairing + templates | adaptation | optimisation | write | total s | S&S worst / mean / var | shape worst / mean | SJ worst / mean | label agreement | unpaired |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+
+fn line(r: &Row) -> String {
+    let s = &r.seconds;
+    format!(
+        "| {} | {} × {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} % | {:.1} % |",
+        r.name,
+        r.width,
+        r.height,
+        r.vertices,
+        r.quads,
+        s.classify,
+        s.sample,
+        s.curves,
+        s.dt,
+        s.pairing_templates,
+        s.adaptation,
+        s.optimise,
+        s.write,
+        s.total,
+        r.shape_and_size[0],
+        r.shape_and_size[1],
+        r.shape_and_size[2],
+        r.shape[0],
+        r.shape[1],
+        r.scaled_jacobian[0],
+        r.scaled_jacobian[1],
+        100.0 * r.label_agreement,
+        100.0 * r.unpaired_share,
+    )
+}
+
+/// The paper's Figure 8 densities (about 1.2 K, 5 K and 10 K quads) on the MRI fixture:
+/// coarser than the defaults by the Imesh threshold and the curve tolerance, finer by a largest
+/// element size.
+fn densities() -> [(&'static str, MeshOptions); 3] {
+    [
+        (
+            "MRI, --te 0.5 --tolerance 10",
+            MeshOptions {
+                te: 0.5,
+                tolerance: 10.0,
+                ..MeshOptions::default()
+            },
+        ),
+        (
+            "MRI, --max-size 10",
+            MeshOptions {
+                max_size: Some(10.0),
+                ..MeshOptions::default()
+            },
+        ),
+        (
+            "MRI, --max-size 7",
+            MeshOptions {
+                max_size: Some(7.0),
+                ..MeshOptions::default()
+            },
+        ),
+    ]
+}
+
+/// Runs the three experiments; `scaling_max` is the largest side of the scaling series.
+pub fn run(scaling_max: u32) -> Result<(), String> {
+    let mut markdown = String::new();
+    let mut table = |title: &str, rows: &[Row]| {
+        let text = format!(
+            "\n### {title}\n\n{HEADER}\n{}\n",
+            rows.iter().map(line).collect::<Vec<_>>().join("\n")
+        );
+        println!("{text}");
+        markdown.push_str(&text);
+    };
+
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(fixtures_dir())
+        .map_err(|e| format!("fixtures/images: {e}"))?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    paths.sort();
+    let mut fixtures = Vec::new();
+    for path in &paths {
+        let image = imesh_classify::load_image(path, imesh_classify::DEFAULT_MAX_PIXELS)
+            .map_err(|e| e.to_string())?;
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        fixtures.push(measure(&name, &image, &MeshOptions::default())?);
+    }
+    table(
+        "Every fixture, default options (the paper's Table I)",
+        &fixtures,
+    );
+
+    let mri = imesh_classify::load_image(
+        &fixtures_dir().join("matplotlib-s1045_mri.png"),
+        imesh_classify::DEFAULT_MAX_PIXELS,
+    )
+    .map_err(|e| e.to_string())?;
+    let mut density = Vec::new();
+    for (name, options) in densities() {
+        density.push(measure(name, &mri, &options)?);
+    }
+    table(
+        "One image at three densities (the paper's Figure 8 / Table II: 17.2 s, 53.5 s, 128.8 s)",
+        &density,
+    );
+
+    let camera = imesh_classify::load_image(
+        &fixtures_dir().join("skimage-camera.png"),
+        imesh_classify::DEFAULT_MAX_PIXELS,
+    )
+    .map_err(|e| e.to_string())?;
+    let mut scaling = Vec::new();
+    let mut side = 256;
+    while side <= scaling_max {
+        let resized = camera.resize_exact(side, side, image::imageops::FilterType::Triangle);
+        scaling.push(measure(
+            &format!("camera {side}²"),
+            &resized,
+            &MeshOptions::default(),
+        )?);
+        side *= 2;
+    }
+    table("Scaling: the camera fixture resized (seconds)", &scaling);
+    let mut memory = format!(
+        "\n### Scaling: peak heap per stage (MB)\n\n| image | {} |\n|---|{}\n",
+        scaling
+            .first()
+            .map(|r| r
+                .peak_bytes
+                .iter()
+                .map(|(s, _)| s.as_str())
+                .collect::<Vec<_>>()
+                .join(" | "))
+            .unwrap_or_default(),
+        "---|".repeat(scaling.first().map_or(0, |r| r.peak_bytes.len()))
+    );
+    for r in &scaling {
+        let cells: Vec<String> = r
+            .peak_bytes
+            .iter()
+            .map(|(_, b)| format!("{:.1}", *b as f64 / 1e6))
+            .collect();
+        memory.push_str(&format!("| {} | {} |\n", r.name, cells.join(" | ")));
+    }
+    println!("{memory}");
+    markdown.push_str(&memory);
+
+    let dir = crate::bench_dir()?;
+    let json = serde_json::json!({
+        "fixtures": fixtures,
+        "densities": density,
+        "scaling": scaling,
+    });
+    std::fs::write(
+        dir.join("pipeline.json"),
+        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| format!("cannot write pipeline.json: {e}"))?;
+    std::fs::write(dir.join("pipeline.md"), markdown)
+        .map_err(|e| format!("cannot write pipeline.md: {e}"))?;
+    println!("written: {0}/pipeline.md, {0}/pipeline.json", dir.display());
+    Ok(())
+}
