@@ -274,3 +274,30 @@ fn a_segment_given_twice_is_one_segment() {
         }
     }
 }
+
+/// A conforming segment that runs along part of an earlier one is refused before anything
+/// changes (it used to be registered first, leaving a segment without edges behind).
+#[test]
+fn an_overlapping_conforming_segment_changes_nothing() {
+    let pts = [
+        Point::new(1.0, 0.0),
+        Point::new(1.0, 1.0),
+        Point::new(1.0, 29.0),
+        Point::new(9.0, 12.0),
+    ];
+    let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    t.insert_segment_conforming(v[1], v[2]).unwrap();
+    let (vertices, triangles) = (t.num_vertices(), t.num_triangles());
+    let err = t.insert_segment_conforming(v[0], v[2]).unwrap_err();
+    assert!(
+        matches!(err, GeomError::CrossingSegments { existing_id: 0, .. }),
+        "{err}"
+    );
+    assert_eq!(t.num_segments(), 1);
+    assert_eq!((t.num_vertices(), t.num_triangles()), (vertices, triangles));
+    t.check().unwrap();
+    // The part that does not overlap is a segment of its own.
+    t.insert_segment_conforming(v[0], v[1]).unwrap();
+    assert_eq!(t.num_segments(), 2);
+    t.check().unwrap();
+}
