@@ -100,3 +100,67 @@ pub fn quality() -> Result<(), String> {
     }
     Ok(())
 }
+
+/// Whether `new` differs from what `path` held, as a word for the report.
+fn change(path: &Path, new: &[u8]) -> &'static str {
+    match std::fs::read(path) {
+        Err(_) => "new",
+        Ok(old) if old == new => "unchanged",
+        Ok(_) => "CHANGED",
+    }
+}
+
+/// The label of pixel `(col, row)` of the synthetic 64 × 64 image behind
+/// `points/disc-boundary.txt`: 1 inside the disc (centre (30.3, 33.7), radius 21) but outside
+/// the elliptic hole (centre (36, 30), semi-axes 7 and 4.5), tested at the pixel's centre.
+fn disc_label(col: i32, row: i32) -> u8 {
+    let (x, y) = (f64::from(col) + 0.5, f64::from(row) + 0.5);
+    let disc = (x - 30.3).powi(2) + (y - 33.7).powi(2) <= 21.0 * 21.0;
+    let hole = ((x - 36.0) / 7.0).powi(2) + ((y - 30.0) / 4.5).powi(2) <= 1.0;
+    u8::from(disc && !hole)
+}
+
+/// The text of `fixtures/points/disc-boundary.txt`: the four domain corners, then the centre
+/// of every pixel with a 4-neighbour of the other label, row by row.
+fn disc_boundary() -> String {
+    let mut text = String::from(
+        "# Label-boundary pixel centres of a 64x64 synthetic image (a disc with an elliptic hole),\n\
+         # plus the four domain corners. One point per line: x y (pixels, y down).\n\
+         0 0\n64 0\n64 64\n0 64\n",
+    );
+    let inside = |c: i32, r: i32| (0..64).contains(&c) && (0..64).contains(&r);
+    for row in 0..64 {
+        for col in 0..64 {
+            let l = disc_label(col, row);
+            let boundary = [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                .iter()
+                .any(|&(dc, dr)| inside(col + dc, row + dr) && disc_label(col + dc, row + dr) != l);
+            if boundary {
+                text.push_str(&format!(
+                    "{} {}\n",
+                    f64::from(col) + 0.5,
+                    f64::from(row) + 0.5
+                ));
+            }
+        }
+    }
+    text
+}
+
+/// `cargo xtask fixtures points`: regenerates `fixtures/points/disc-boundary.txt`.
+pub fn points() -> Result<(), String> {
+    let path = workspace_root()?.join("fixtures/points/disc-boundary.txt");
+    let text = disc_boundary();
+    let state = change(&path, text.as_bytes());
+    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    println!("fixtures/points/disc-boundary.txt: {state}");
+    Ok(())
+}
+
+/// `cargo xtask fixtures`: regenerates everything under `fixtures/` this project derives (the
+/// synthetic point set and the Verdict reference tables) and says what changed. The images are
+/// byte-for-byte copies of `../shared/fixtures/` (see fixtures/README.md), not derived here.
+pub fn all() -> Result<(), String> {
+    points()?;
+    quality()
+}

@@ -6,7 +6,7 @@
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE]
 //! cargo xtask compare gmsh
-//! cargo xtask fixtures quality
+//! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
 //! ```
 
@@ -26,7 +26,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE]
        cargo xtask compare gmsh
-       cargo xtask fixtures quality
+       cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
 
   bench delaunay   our Delaunay kernel against spade and delaunator on the same inputs;
@@ -54,8 +54,10 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    both measured with our metrics; Gmsh from PyPI into target/venv-gmsh;
                    writes target/bench/compare-gmsh.json
 
-  fixtures quality regenerate fixtures/quality/ (the Verdict reference table) with VTK's
-                   vtkMeshQuality, installed from PyPI into target/venv-vtk
+  fixtures         regenerate everything under fixtures/ that this project derives, and say
+                   what changed: points/disc-boundary.txt (a synthetic label boundary) and
+                   quality/ (the Verdict reference tables; VTK from PyPI into target/venv-vtk);
+                   `fixtures points` or `fixtures quality` for one of them
 
   fuzz             coverage-guided fuzzing (cargo-fuzz, libFuzzer, nightly) of the harnesses
                    in fuzz/harness.rs: delaunay, refine, simplify, pipeline, decode (all when
@@ -118,6 +120,8 @@ fn run(args: &[String]) -> Result<(), String> {
         }
         ["compare", "gmsh"] => compare_gmsh::run(),
         ["fixtures", "quality"] => fixtures::quality(),
+        ["fixtures", "points"] => fixtures::points(),
+        ["fixtures"] => fixtures::all(),
         ["fuzz", rest @ ..] => {
             let mut options = fuzz::Options {
                 targets: Vec::new(),
