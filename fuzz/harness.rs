@@ -228,7 +228,12 @@ fn assert_segments_conform(t: &Triangulation, conforming: bool, when: &str) {
                     chain.iter().map(|&v| t.point(v)).collect::<Vec<_>>()
                 );
             };
-            assert!(t.is_constrained(e), "{when}");
+            assert!(
+                t.is_constrained(e),
+                "{when}: segment {s:?} ({pa:?}–{pz:?}, conforming {conforming}): its piece {:?}–{:?} is not constrained",
+                t.point(w[0]),
+                t.point(w[1])
+            );
             // Split points are rounded: within a few ulps of the segment, not exactly on it.
             let p = t.point(w[1]);
             let d =

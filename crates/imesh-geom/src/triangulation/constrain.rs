@@ -219,7 +219,7 @@ impl Triangulation {
         // Trace the whole segment first, so that a crossing leaves the triangulation unchanged.
         let mut from = a.0;
         while from != b.0 {
-            from = match self.trace_piece(from, b.0, false)? {
+            from = match self.trace_piece(from, b.0)? {
                 Piece::Edge(_, c) => c,
                 Piece::Crossing { end, .. } => end,
             };
@@ -274,11 +274,9 @@ impl Triangulation {
 
     /// Traces the piece of a segment from `a` towards `b` up to the first vertex on it, without
     /// changing anything: the edge it runs along, or the edges it crosses.
-    ///
-    /// A piece that runs along another segment is an overlap ([`GeomError::CrossingSegments`]);
-    /// so is crossing one, unless `may_cross` (a conforming segment splits the segments it
-    /// crosses).
-    fn trace_piece(&self, a: u32, b: u32, may_cross: bool) -> Result<Piece, GeomError> {
+    /// A piece that runs along or crosses another segment is an error
+    /// ([`GeomError::CrossingSegments`]).
+    fn trace_piece(&self, a: u32, b: u32) -> Result<Piece, GeomError> {
         let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
         let crossing = match self.first_step(a, b) {
             Some(Step::AlongEdge(h, c)) => {
@@ -305,11 +303,7 @@ impl Triangulation {
         let mut crossed: Vec<[u32; 2]> = Vec::new();
         let mut e = crossing;
         loop {
-            if let Some(&s) = self
-                .segment
-                .get(e as usize)
-                .filter(|&&s| s != NONE && !may_cross)
-            {
+            if let Some(&s) = self.segment.get(e as usize).filter(|&&s| s != NONE) {
                 return Err(GeomError::CrossingSegments {
                     new: [a, b],
                     existing: self.segments[s as usize],
@@ -341,7 +335,7 @@ impl Triangulation {
     /// segment; returns that vertex.
     fn constrain_piece(&mut self, a: u32, b: u32, id: u32) -> Result<u32, GeomError> {
         let pa = self.points[a as usize];
-        let (crossed, end) = match self.trace_piece(a, b, false)? {
+        let (crossed, end) = match self.trace_piece(a, b)? {
             Piece::Edge(h, c) => {
                 self.mark(h, id, a, c)?;
                 return Ok(c);
@@ -454,7 +448,9 @@ impl Triangulation {
     /// an earlier one, either way round: nothing changes).
     ///
     /// # Errors
-    /// As [`insert_segment`](Self::insert_segment).
+    /// As [`insert_segment`](Self::insert_segment): crossing or overlapping an earlier segment is
+    /// refused before anything changes. A failure while splitting (a piece too short to split in
+    /// floating point) gives the new segment up and leaves the earlier ones whole.
     ///
     /// ```
     /// use imesh_geom::{Point, Triangulation};
@@ -462,8 +458,10 @@ impl Triangulation {
     /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
     /// let steiner = t.insert_segment_conforming(v[2], v[3]).unwrap();
     /// assert!(steiner.is_empty()); // already a Delaunay edge
+    /// assert!(t.insert_segment_conforming(v[0], v[1]).is_err()); // it would cross v2–v3
+    /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
     /// let steiner = t.insert_segment_conforming(v[0], v[1]).unwrap();
-    /// assert_eq!(t.point(steiner[0]), Point::new(4.0, 0.0)); // crosses v2–v3, split there
+    /// assert_eq!(t.point(steiner[0]), Point::new(4.0, 0.0)); // v2 and v3 see it at 90°: split
     /// t.check().unwrap();
     /// ```
     pub fn insert_segment_conforming(
@@ -476,10 +474,12 @@ impl Triangulation {
             return Ok(Vec::new());
         }
         self.ensure_constraint_storage();
-        // Trace the whole segment first, so that an overlap leaves the triangulation unchanged.
+        // Trace the whole segment first, so that a crossing or an overlap leaves the
+        // triangulation unchanged. (Splitting both segments where they cross would need a
+        // vertex at the crossing, which floating point cannot put on both lines.)
         let mut from = a.0;
         while from != b.0 {
-            from = match self.trace_piece(from, b.0, true)? {
+            from = match self.trace_piece(from, b.0)? {
                 Piece::Edge(_, c) => c,
                 Piece::Crossing { end, .. } => end,
             };
@@ -493,9 +493,39 @@ impl Triangulation {
         // which is then recovered in turn), with conforming pieces not blocking the insertions, so
         // that the triangulation stays Delaunay.
         self.unblock_conforming = true;
-        let result = self.recover_conforming_pieces(n_input);
+        let result = self
+            .recover_conforming_pieces(n_input)
+            .and_then(|()| self.mark_conforming_pieces());
+        if let Err(e) = result {
+            // Give the new segment up. Its Steiner points stay (the triangulation is Delaunay
+            // with them), but they may have split or flipped away pieces of earlier conforming
+            // segments: recover and mark those again, so that the error leaves every earlier
+            // segment whole.
+            self.segments.pop();
+            self.chains.pop();
+            for s in &mut self.segment {
+                if *s == id {
+                    *s = NONE;
+                }
+            }
+            let restored = self
+                .recover_conforming_pieces(n_input)
+                .and_then(|()| self.mark_conforming_pieces());
+            self.unblock_conforming = false;
+            restored?;
+            return Err(e);
+        }
         self.unblock_conforming = false;
-        result?;
+        Ok(self.chains[id as usize]
+            .iter()
+            .copied()
+            .filter(|&v| v as usize >= before)
+            .map(VertexId)
+            .collect())
+    }
+
+    /// Marks every piece of every conforming segment's chain as a constrained edge of its segment.
+    fn mark_conforming_pieces(&mut self) -> Result<(), GeomError> {
         for s in 0..self.chains.len() {
             for i in 1..self.chains[s].len() {
                 let (u, w) = (self.chains[s][i - 1], self.chains[s][i]);
@@ -509,12 +539,7 @@ impl Triangulation {
                 self.mark(h.0, s as u32, u, w)?;
             }
         }
-        Ok(self.chains[id as usize]
-            .iter()
-            .copied()
-            .filter(|&v| v as usize >= before)
-            .map(VertexId)
-            .collect())
+        Ok(())
     }
 
     /// Splits conforming pieces that are not edges until all are.
