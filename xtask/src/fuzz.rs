@@ -91,8 +91,10 @@ pub fn run(options: &Options) -> Result<(), String> {
             ])
             .status()
             .map_err(|e| format!("cannot run cargo fuzz: {e}"))?;
+        // libFuzzer exits non-zero when it found failing inputs (the table below counts them);
+        // a build failure leaves no corpus to speak of and shows in cargo's output above.
         if !status.success() {
-            return Err(format!("cargo fuzz run {target} failed ({status})"));
+            println!("cargo fuzz run {target}: {status}");
         }
         rows.push((
             target,
