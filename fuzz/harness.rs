@@ -9,9 +9,9 @@
 
 use imesh::{Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline, PipelineError};
 use imesh_classify::{LabelGrid, Region};
-use imesh_curves::{segment_distance, CurveGraph, GraphEdge, SimplifyOptions};
+use imesh_curves::{segment_distance, CurveGraph, SimplifyOptions};
 use imesh_geom::{
-    GeomError, Location, Point, RefineOptions, StopReason, TriangleId, Triangulation, EXTERIOR,
+    GeomError, Location, Point, RefineOptions, StopReason, TriangleId, Triangulation,
 };
 use imesh_segment::{SampleOptions, SegmentedMesh};
 
@@ -152,7 +152,6 @@ pub fn refine(data: &[u8]) {
         return;
     }
     let conforming = b.u8() % 2 == 1;
-    let mut segments = Vec::new();
     for _ in 0..(b.u8() % 24) {
         let (i, j) = (usize::from(b.u8()) % n, usize::from(b.u8()) % n);
         let inserted = if conforming {
@@ -161,8 +160,7 @@ pub fn refine(data: &[u8]) {
             t.insert_segment(ids[i], ids[j]).map(|_| ())
         };
         match inserted {
-            Ok(()) => segments.push((ids[i], ids[j])),
-            Err(GeomError::CrossingSegments { .. } | GeomError::BadSegment { .. }) => {}
+            Ok(()) | Err(GeomError::CrossingSegments { .. } | GeomError::BadSegment { .. }) => {}
             Err(e) => panic!("segment: {e}"),
         }
         if let Err(e) = t.check() {
@@ -205,8 +203,6 @@ pub fn refine(data: &[u8]) {
         }
     }
     assert_segments_conform(&t, conforming, "after refinement");
-    let _ = segments;
-    let _ = EXTERIOR;
 }
 
 /// Every segment of `t` is a chain of constrained edges from end to end, each vertex within
@@ -310,20 +306,7 @@ pub fn simplify(data: &[u8]) {
         Ok(s) => s,
         Err(e) => panic!("sampling: {e}"),
     };
-    let edges = segmented
-        .c_edges
-        .iter()
-        .map(|e| GraphEdge {
-            ends: e.vertices.map(|v| v.index() as u32),
-            labels: e.labels,
-        })
-        .collect();
-    let g = match CurveGraph::image_boundaries(
-        segmented.triangulation.points().to_vec(),
-        edges,
-        f64::from(grid.width()),
-        f64::from(grid.height()),
-    ) {
+    let g = match imesh::boundary_graph(&segmented) {
         Ok(g) => g,
         Err(e) => panic!("c-edge graph: {e}"),
     };

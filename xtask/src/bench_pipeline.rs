@@ -77,14 +77,16 @@ fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Re
     let write = write.elapsed().as_secs_f64();
     let total = clock.elapsed().as_secs_f64();
     let _ = std::fs::remove_file(&path);
-    let mut stages = peaks.lock().map_err(|_| "poisoned")?.clone();
+    let stages = peaks.lock().map_err(|_| "poisoned")?;
     // Stage k's peak was read when stage k + 1 began; the last one's at the end.
-    let mut peak_bytes = Vec::new();
-    for k in 0..stages.len() {
-        let peak = stages.get(k + 1).map_or(last_peak, |s| s.1);
-        peak_bytes.push((format!("{:?}", stages[k].0).to_lowercase(), peak));
-    }
-    stages.clear();
+    let peak_bytes: Vec<(String, usize)> = stages
+        .iter()
+        .enumerate()
+        .map(|(k, (stage, _))| {
+            let peak = stages.get(k + 1).map_or(last_peak, |s| s.1);
+            (format!("{stage:?}").to_lowercase(), peak)
+        })
+        .collect();
     let r = &result.report;
     let s = &r.seconds;
     let q = &r.quality;

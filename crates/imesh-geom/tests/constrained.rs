@@ -264,13 +264,10 @@ fn a_segment_given_twice_is_one_segment() {
         })
         .unwrap();
         t.check().unwrap();
+        assert_segments_are_edge_chains(&t);
         for s in 0..t.num_segments() {
             let chain = t.segment_vertices(SegmentId(s as u32));
             assert!(chain.len() > 2, "segment {s} was split");
-            for w in chain.windows(2) {
-                let e = t.find_edge(w[0], w[1]).expect("every piece is an edge");
-                assert_eq!(t.segment_of(e), Some(SegmentId(s as u32)));
-            }
         }
     }
 }
@@ -325,9 +322,5 @@ fn crossing_conforming_segments_are_an_error_and_change_nothing() {
     assert_eq!(t.num_segments(), 1);
     assert_eq!((t.num_vertices(), t.num_triangles()), (vertices, triangles));
     t.check().unwrap();
-    let chain = t.segment_vertices(SegmentId(0));
-    for w in chain.windows(2) {
-        let e = t.find_edge(w[0], w[1]).expect("a piece is an edge");
-        assert_eq!(t.segment_of(e), Some(SegmentId(0)));
-    }
+    assert_segments_are_edge_chains(&t);
 }

@@ -890,20 +890,7 @@ impl Pipeline {
         let o = &self.options;
         let start = Instant::now();
         self.stage(Stage::Curves);
-        let edges = segmented
-            .c_edges
-            .iter()
-            .map(|e| GraphEdge {
-                ends: e.vertices.map(|v| v.index() as u32),
-                labels: e.labels,
-            })
-            .collect();
-        let g = CurveGraph::image_boundaries(
-            segmented.triangulation.points().to_vec(),
-            edges,
-            f64::from(segmented.width),
-            f64::from(segmented.height),
-        )?;
+        let g = boundary_graph(segmented)?;
         let simplified = simplify(
             &g,
             &SimplifyOptions {
@@ -1133,6 +1120,28 @@ impl Pipeline {
 
 /// Vertices, elements and labels of a mesh.
 type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
+
+/// The boundary graph G of an Imesh partition: its c-edges, with the domain corners pinned (the
+/// curve stage's input).
+///
+/// # Errors
+/// [`imesh_curves::CurveError`] if the c-edges do not make a valid graph (a bug in the sampler).
+pub fn boundary_graph(segmented: &SegmentedMesh) -> Result<CurveGraph, imesh_curves::CurveError> {
+    let edges = segmented
+        .c_edges
+        .iter()
+        .map(|e| GraphEdge {
+            ends: e.vertices.map(|v| v.index() as u32),
+            labels: e.labels,
+        })
+        .collect();
+    CurveGraph::image_boundaries(
+        segmented.triangulation.points().to_vec(),
+        edges,
+        f64::from(segmented.width),
+        f64::from(segmented.height),
+    )
+}
 
 /// The area of the equilateral triangle of side `s`.
 fn equilateral_area(s: f64) -> f64 {
