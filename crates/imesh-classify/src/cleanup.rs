@@ -2,8 +2,6 @@
 
 use std::collections::HashMap;
 
-use image::{ImageBuffer, Luma};
-use imageproc::region_labelling::{connected_components, Connectivity};
 use rayon::prelude::*;
 
 use crate::LabelGrid;
@@ -23,11 +21,7 @@ use crate::LabelGrid;
 /// ```
 pub fn remove_small_regions(grid: &LabelGrid, min_pixels: usize) -> LabelGrid {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
-    let img: ImageBuffer<Luma<u32>, Vec<u32>> =
-        ImageBuffer::from_raw(grid.width(), grid.height(), grid.labels().to_vec())
-            .expect("the grid has W×H labels");
-    // No label equals u32::MAX, so every pixel belongs to some component (ids from 1).
-    let comp = connected_components(&img, Connectivity::Four, Luma([u32::MAX])).into_raw();
+    let comp = four_connected_components(grid.labels(), w, h);
     let n = comp.iter().copied().max().unwrap_or(0) as usize + 1;
     let mut size = vec![0usize; n];
     let mut label = vec![0u32; n];
@@ -136,4 +130,72 @@ pub fn majority_filter(grid: &LabelGrid, radius: u32, iterations: u32) -> LabelG
         labels = next;
     }
     grid.with_labels(labels)
+}
+
+/// A component id (from 0) per pixel: 4-connected pixels of one label share it. (imageproc's
+/// `connected_components` sizes its union-find too small when nearly every pixel is its own
+/// component, and panics on a 1 × 1 image or a label map of single pixels; a flood fill has no
+/// such limit.)
+fn four_connected_components(labels: &[u32], w: usize, h: usize) -> Vec<u32> {
+    let mut comp = vec![u32::MAX; labels.len()];
+    let mut stack = Vec::new();
+    let mut next = 0u32;
+    for start in 0..labels.len() {
+        if comp[start] != u32::MAX {
+            continue;
+        }
+        comp[start] = next;
+        stack.push(start);
+        while let Some(i) = stack.pop() {
+            let (x, y) = (i % w, i / w);
+            let around = [
+                (x > 0).then(|| i - 1),
+                (x + 1 < w).then(|| i + 1),
+                (y > 0).then(|| i - w),
+                (y + 1 < h).then(|| i + w),
+            ];
+            for j in around.into_iter().flatten() {
+                if comp[j] == u32::MAX && labels[j] == labels[i] {
+                    comp[j] = next;
+                    stack.push(j);
+                }
+            }
+        }
+        next += 1;
+    }
+    comp
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Region;
+
+    /// Grids where every pixel is its own region (imageproc's labelling panicked on these): the
+    /// small regions merge until one is big enough, whatever the shape.
+    #[test]
+    fn single_pixel_regions_of_tiny_grids_merge() {
+        let r = |n: u32| Region {
+            name: n.to_string(),
+            colour: [0, 0, 0],
+        };
+        for (w, h) in [(1u32, 1u32), (1, 5), (5, 1), (2, 2), (3, 3)] {
+            let labels: Vec<u32> = (0..w * h).collect();
+            let g = LabelGrid::new(w, h, labels, (0..w * h).map(r).collect()).unwrap();
+            let clean = remove_small_regions(&g, 4);
+            let kept = clean.num_labels();
+            assert!(
+                kept >= 1 && kept <= ((w * h) as usize / 4).max(1),
+                "{w}×{h}: {kept} labels"
+            );
+            assert_eq!(
+                four_connected_components(clean.labels(), w as usize, h as usize)
+                    .iter()
+                    .max()
+                    .map(|&m| m as usize + 1),
+                Some(kept),
+                "{w}×{h}: a label in two pieces"
+            );
+        }
+    }
 }

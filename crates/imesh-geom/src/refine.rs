@@ -399,6 +399,65 @@ impl Triangulation {
         Ok(report)
     }
 
+    /// Splits every constrained edge longer than `max_length` into the fewest equal pieces no
+    /// longer than it, and returns the number of points inserted. The split points lie on their
+    /// segment's line (exactly, when its ends are on a coarse lattice) and the halves keep the
+    /// segment and the labels on both sides. A uniform spacing along the boundaries is what a
+    /// uniformly sized mesh starts from: refinement alone grades from short boundary pieces.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(10.0, 0.0), Point::new(0.0, 3.0)];
+    /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    /// let s = t.insert_segment(v[0], v[1]).unwrap();
+    /// t.split_long_segments(4.0).unwrap();
+    /// let xs: Vec<f64> = t.segment_vertices(s).iter().map(|&u| t.point(u).x).collect();
+    /// assert_eq!(xs.len(), 4); // 10 / 4 → 3 pieces of 10/3
+    /// assert!(xs.windows(2).all(|w| (w[1] - w[0] - 10.0 / 3.0).abs() < 1e-9));
+    /// t.check().unwrap();
+    /// ```
+    ///
+    /// # Errors
+    /// [`GeomError::OutOfRange`] if a split point cannot be represented (it cannot happen for
+    /// points the triangulation accepted).
+    pub fn split_long_segments(&mut self, max_length: f64) -> Result<usize, GeomError> {
+        if !(max_length.is_finite() && max_length > 0.0) || self.segment.is_empty() {
+            return Ok(0);
+        }
+        let edges: Vec<[u32; 2]> = self
+            .constrained_edges()
+            .map(|h| [self.origin[h.index()], self.origin[next(h.0) as usize]])
+            .collect();
+        let before = self.points.len();
+        for [u, w] in edges {
+            let (pu, pw) = (self.points[u as usize], self.points[w as usize]);
+            let pieces = (pu.distance_squared(pw).sqrt() / max_length).ceil();
+            // (NaN for coincident ends fails this too.)
+            if pieces.is_nan() || pieces < 2.0 {
+                continue;
+            }
+            // Peel one piece off the front at a time: the next point splits what is left into
+            // the remaining number of equal parts, so rounding does not accumulate.
+            let mut at = u;
+            for left in (2..=pieces as usize).rev() {
+                let Some(h) = self
+                    .find_edge(VertexId(at), VertexId(w))
+                    .filter(|&h| self.is_constrained(h))
+                else {
+                    break;
+                };
+                let pa = self.points[at as usize];
+                let p = self.snap_to_segment(h.0, pa + (pw - pa) * (1.0 / left as f64));
+                let v = self.insert_on_edge(h.0, p)?.0;
+                if v == at || v == w {
+                    break;
+                }
+                at = v;
+            }
+        }
+        Ok(self.points.len() - before)
+    }
+
     /// Marks every hull edge as a segment (the domain border).
     fn constrain_hull(&mut self) -> Result<(), GeomError> {
         let hull = self.hull();

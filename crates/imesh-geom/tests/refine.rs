@@ -339,3 +339,50 @@ fn a_policy_veto_splits_segments_instead() {
     }
     assert!(r.inserted > 0);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Splitting long segments: every constrained edge ends no longer than the bound, every
+    /// segment is still a chain of constrained edges from its first end to its second, its
+    /// pieces are equal within rounding, and the triangulation stays constrained Delaunay.
+    #[test]
+    fn long_segments_split_into_equal_pieces(coords in prop::collection::vec((0u32..60, 0u32..60), 4..20), pairs in prop::collection::vec((0usize..20, 0usize..20), 1..20), max_length in 0.7..9.0f64) {
+        let pts: Vec<Point> = coords.iter().map(|&(x, y)| Point::new(f64::from(x), f64::from(y))).collect();
+        let Ok((mut t, ids)) = Triangulation::from_points(&pts) else { return Ok(()) };
+        for &(i, j) in &pairs {
+            let (i, j) = (i % pts.len(), j % pts.len());
+            if ids[i] != ids[j] {
+                let _ = t.insert_segment(ids[i], ids[j]);
+            }
+        }
+        let lengths: Vec<(f64, usize)> = (0..t.num_segments())
+            .map(|s| {
+                let chain = t.segment_vertices(imesh_geom::SegmentId(s as u32));
+                let [a, b] = [chain[0], chain[chain.len() - 1]].map(|v| t.point(v));
+                (a.distance_squared(b).sqrt(), chain.len() - 1)
+            })
+            .collect();
+        t.split_long_segments(max_length).unwrap();
+        t.check().unwrap();
+        for e in t.constrained_edges() {
+            let (a, b) = (t.point(t.origin(e)), t.point(t.destination(e)));
+            prop_assert!(a.distance_squared(b).sqrt() <= max_length * (1.0 + 1e-9));
+        }
+        for (s, &(length, pieces_before)) in lengths.iter().enumerate() {
+            let chain = t.segment_vertices(imesh_geom::SegmentId(s as u32));
+            for w in chain.windows(2) {
+                prop_assert!(t.find_edge(w[0], w[1]).is_some_and(|e| t.is_constrained(e)));
+            }
+            // A segment without vertices on it is cut into ⌈length / bound⌉ equal pieces.
+            if pieces_before == 1 {
+                let pieces = (length / max_length).ceil().max(1.0);
+                prop_assert_eq!(chain.len() - 1, pieces as usize);
+                for w in chain.windows(2) {
+                    let d = t.point(w[0]).distance_squared(t.point(w[1])).sqrt();
+                    prop_assert!((d - length / pieces).abs() < 1e-9 * length.max(1.0));
+                }
+            }
+        }
+    }
+}

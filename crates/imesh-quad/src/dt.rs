@@ -20,6 +20,11 @@ pub struct DensityOptions {
     /// Largest element size in pixels: triangles larger than the equilateral triangle of this
     /// side are refined.
     pub max_size: Option<f64>,
+    /// Spacing of a uniform DT', in pixels: boundaries are split into pieces no longer than
+    /// this, and the inside away from them is filled with an axis-aligned square lattice of this
+    /// spacing before refinement ([`uniform_points`]). `None` leaves DT' graded from the boundary
+    /// pieces inwards.
+    pub spacing: Option<f64>,
 }
 
 impl Default for DensityOptions {
@@ -28,6 +33,7 @@ impl Default for DensityOptions {
             min_angle_deg: 20.7,
             max_steiner: usize::MAX,
             max_size: None,
+            spacing: None,
         }
     }
 }
@@ -53,7 +59,8 @@ impl RegionTriangulation {
     /// on their sides, and refines to `options`.
     ///
     /// # Errors
-    /// [`QuadError::EmptyGraph`] for a graph without edges; [`QuadError::Geometry`] if a G' edge
+    /// [`QuadError::EmptyGraph`] for a graph without edges; [`QuadError::LatticeTooFine`] for a
+    /// spacing whose lattice exceeds `max_steiner`; [`QuadError::Geometry`] if a G' edge
     /// cannot be inserted (crossing edges: G' was not planar) or for a bad angle.
     ///
     /// ```
@@ -113,6 +120,17 @@ impl RegionTriangulation {
         }
         let labels = region_labels(&triangulation, &segment_edge, g);
         triangulation.set_labels(|t| labels[t.index()]);
+        if let Some(h) = options.spacing {
+            let points = crate::density::lattice_points(&triangulation, h);
+            if points > options.max_steiner as u64 {
+                return Err(QuadError::LatticeTooFine {
+                    spacing: h,
+                    points,
+                    limit: options.max_steiner as u64,
+                });
+            }
+            crate::uniform_points(&mut triangulation, h)?;
+        }
         let refine = RefineOptions {
             min_angle_deg: options.min_angle_deg,
             max_steiner: options.max_steiner,

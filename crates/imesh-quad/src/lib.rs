@@ -39,6 +39,7 @@
 //! ```
 
 mod adapt;
+mod density;
 mod dt;
 mod mesh;
 mod pairing;
@@ -46,6 +47,7 @@ mod patch;
 mod template;
 
 pub use adapt::{adapt, AdaptReport, EdgeCurve};
+pub use density::{uniform_points, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, NONE};
 pub use mesh::{Holder, QuadMesh};
 pub use pairing::{Element, ElementMesh, Pairing};
@@ -84,6 +86,16 @@ pub enum QuadError {
         /// Quads the templates would make.
         quads: u64,
         /// The limit.
+        limit: u64,
+    },
+    /// The uniform DT''s lattice would hold more points than refinement may insert.
+    #[error("a uniform DT' of spacing {spacing} px would hold {points} lattice points, over the limit of {limit}: give a larger element size")]
+    LatticeTooFine {
+        /// The spacing asked for.
+        spacing: f64,
+        /// Lattice points over the domain.
+        points: u64,
+        /// The limit (the refinement cap).
         limit: u64,
     },
 }

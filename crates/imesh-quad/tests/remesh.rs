@@ -373,3 +373,111 @@ fn a_triangle_side_depends_on_its_own_control_points_only() {
         }
     }
 }
+
+/// A uniform DT' (`spacing`): the mesh keeps every invariant, no boundary piece is longer than
+/// the spacing, every point off the boundaries keeps its clearance, and the inside is the
+/// lattice's squares: far more quads are perfect squares of the lattice's size than with the
+/// graded DT'.
+#[test]
+fn a_uniform_dt_is_a_valid_mesh_of_lattice_squares_inside() {
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let spacing = 6.0;
+        let uniform = QuadOptions {
+            density: DensityOptions {
+                spacing: Some(spacing),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let r = run(&c, &uniform);
+        check_mesh(&r, &c, &r.straight_vertices);
+        check_mesh(&r, &c, &r.mesh.vertices);
+        assert_eq!(r.adaptation.invalid_left, 0, "{name}: {:?}", r.adaptation);
+        let t = &r.dt.triangulation;
+        // Lattice points are exactly on the lattice; refinement's are not.
+        let (nx, ny) = ((c.width / spacing).round(), (c.height / spacing).round());
+        let (hx, hy) = (c.width / nx, c.height / ny);
+        let on_lattice = |p: Point| {
+            let (i, j) = ((p.x / hx).round(), (p.y / hy).round());
+            (p.x - i * hx).abs() < 1e-9 && (p.y - j * hy).abs() < 1e-9
+        };
+        let pieces: Vec<[Point; 2]> = t
+            .constrained_edges()
+            .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
+            .collect();
+        for &[a, b] in &pieces {
+            assert!(
+                a.distance_squared(b).sqrt() <= spacing * (1.0 + 1e-9),
+                "{name}: long piece"
+            );
+        }
+        let mut lattice = 0;
+        for v in t.vertices() {
+            let p = t.point(v);
+            let inside = p.x > 0.0 && p.y > 0.0 && p.x < c.width && p.y < c.height;
+            if !(inside && on_lattice(p)) || pieces.iter().any(|&[a, b]| a == p || b == p) {
+                continue;
+            }
+            lattice += 1;
+            let nearest = pieces
+                .iter()
+                .map(|&[a, b]| segment_distance(a, b, p))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest >= imesh_quad::CLEARANCE * spacing * (1.0 - 1e-9),
+                "{name}: lattice point {p:?} at {nearest} from a boundary"
+            );
+        }
+        assert!(lattice > 0, "{name}: no lattice point inside");
+        // Quads that are exact squares of side spacing / 2 (before adaptation and optimisation).
+        let squares = |r: &Remesh| {
+            r.mesh
+                .quads
+                .iter()
+                .filter(|q| {
+                    let p = q.map(|v| r.straight_vertices[v as usize]);
+                    (0..4).all(|i| {
+                        let (a, b, d) = (p[i], p[(i + 1) % 4], p[(i + 3) % 4]);
+                        let (u, w) = (b - a, d - a);
+                        let side =
+                            |s: Point, h: f64| ((s.x.abs() + s.y.abs()) - h / 2.0).abs() < 1e-6;
+                        (u.x * w.x + u.y * w.y).abs() < 1e-9 && (side(u, hx) || side(u, hy))
+                    })
+                })
+                .count()
+        };
+        let graded = run(&c, &QuadOptions::default());
+        let (s_uniform, s_graded) = (squares(&r), squares(&graded));
+        eprintln!(
+            "{name}: {s_uniform} lattice squares of {} quads (graded: {s_graded} of {})",
+            r.mesh.quads.len(),
+            graded.mesh.quads.len()
+        );
+        assert!(
+            s_uniform * 10 > r.mesh.quads.len() && s_uniform > 4 * s_graded,
+            "{name}: {s_uniform} squares of {} quads, graded {s_graded}",
+            r.mesh.quads.len()
+        );
+    }
+}
+
+/// A spacing whose lattice would exceed the refinement cap is refused before any point is
+/// inserted.
+#[test]
+fn a_lattice_over_the_cap_is_refused() {
+    let c = curves(&support::fixture(FIXTURES[0]));
+    let options = QuadOptions {
+        density: DensityOptions {
+            spacing: Some(0.5),
+            max_steiner: 1000,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let curves: Vec<_> = c.fits.fits.iter().map(|f| f.curve).collect();
+    assert!(matches!(
+        remesh(&c.simplified.graph, &curves, &options),
+        Err(QuadError::LatticeTooFine { limit: 1000, .. })
+    ));
+}

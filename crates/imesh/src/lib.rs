@@ -66,6 +66,63 @@ impl FromStr for PairingMethod {
     }
 }
 
+/// How large the quads are (`--size`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(into = "String", try_from = "String")]
+pub enum ElementSize {
+    /// Uniform, at the spacing the simplified boundaries suggest: the upper quartile of their
+    /// edge lengths, at least [`MIN_AUTO_SPACING`] pixels, as the spacing of DT'.
+    Auto,
+    /// Uniform quads of about this side, in pixels (DT' spacing: 2 × level × this).
+    Pixels(f64),
+    /// DT' graded from the boundaries' own pieces inwards, by refinement alone (the paper's;
+    /// default): fewer elements, lower shape-and-size.
+    Graded,
+}
+
+/// Smallest DT' spacing `--size auto` chooses, in pixels: finer boundaries than this are met by
+/// refinement, not by a finer lattice everywhere.
+pub const MIN_AUTO_SPACING: f64 = 4.0;
+
+impl FromStr for ElementSize {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Self::Auto),
+            "graded" => Ok(Self::Graded),
+            _ => match s.parse::<f64>() {
+                Ok(px) if px.is_finite() && px > 0.0 => Ok(Self::Pixels(px)),
+                _ => Err(format!(
+                    "unknown element size {s:?}: use auto, graded or a positive number of pixels"
+                )),
+            },
+        }
+    }
+}
+
+impl std::fmt::Display for ElementSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Auto => f.write_str("auto"),
+            Self::Graded => f.write_str("graded"),
+            Self::Pixels(px) => write!(f, "{px}"),
+        }
+    }
+}
+
+impl From<ElementSize> for String {
+    fn from(s: ElementSize) -> Self {
+        s.to_string()
+    }
+}
+
+impl TryFrom<String> for ElementSize {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+    }
+}
+
 /// How the quads are optimised (`--optimizer`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -159,6 +216,11 @@ pub struct MeshOptions {
     /// Largest element size in pixels (the side of the largest equilateral triangle allowed
     /// before pairing or in the triangle mesh), if any.
     pub max_size: Option<f64>,
+    /// Size of the quads: uniform (`auto`, or a side in pixels) or graded.
+    pub size: ElementSize,
+    /// Regions (4-connected) smaller than this many pixels are merged into the neighbour they
+    /// share the longest border with before meshing (0: every region is kept).
+    pub min_region: usize,
     /// Curve simplification tolerance in pixels (quads).
     pub tolerance: f64,
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² (1–8).
@@ -196,6 +258,8 @@ impl Default for MeshOptions {
             min_angle: None,
             max_steiner: None,
             max_size: None,
+            size: ElementSize::Graded,
+            min_region: 0,
             tolerance: imesh_curves::DEFAULT_TOLERANCE,
             template_level: 1,
             pairing: PairingMethod::Matching,
@@ -276,6 +340,9 @@ pub struct Counts {
     pub height: u32,
     /// Labels in the label grid.
     pub labels: usize,
+    /// Pixels whose small region `min_region` merged into a neighbour (label agreement is
+    /// measured against the merged grid).
+    pub merged_pixels: usize,
     /// Pixel centres Imesh sampled.
     pub sampled_vertices: usize,
     /// c-edges of the partition.
@@ -288,6 +355,8 @@ pub struct Counts {
     pub simplified_edges: usize,
     /// Triangles of DT' (quads).
     pub dt_triangles: usize,
+    /// Spacing of the uniform DT' in pixels (quads; 0 when graded).
+    pub dt_spacing: f64,
     /// DT' triangles left unpaired (quads).
     pub unpaired_triangles: usize,
     /// G' edges whose curve was flattened to keep every quad valid (quads).
@@ -682,6 +751,24 @@ impl Pipeline {
         self.check_options()?;
         self.check_size(grid.width(), grid.height())?;
         let start = Instant::now();
+        let cleaned;
+        let mut merged_pixels = 0;
+        let grid = if o.min_region > 1 {
+            cleaned = imesh_classify::remove_small_regions(grid, o.min_region);
+            // Labels are renumbered when regions vanish: compare by region name.
+            fn name(g: &LabelGrid, l: u32) -> Option<&str> {
+                g.regions().get(l as usize).map(|r| r.name.as_str())
+            }
+            merged_pixels = grid
+                .labels()
+                .iter()
+                .zip(cleaned.labels())
+                .filter(|&(&a, &b)| name(grid, a) != name(&cleaned, b))
+                .count();
+            &cleaned
+        } else {
+            grid
+        };
         self.stage(Stage::Sample);
         let mut segmented = SegmentedMesh::from_grid(
             grid,
@@ -702,6 +789,7 @@ impl Pipeline {
             labels: grid.num_labels(),
             sampled_vertices: segmented.inserted,
             c_edges: segmented.c_edges.len(),
+            merged_pixels,
             ..Default::default()
         };
         let mut pictures = Pictures {
@@ -921,6 +1009,7 @@ impl Pipeline {
                         .unwrap_or(DensityOptions::default().min_angle_deg),
                     max_steiner: self.refinement_cap(),
                     max_size: o.max_size,
+                    spacing: self.dt_spacing(&simplified.graph),
                 },
                 pairing: match o.pairing {
                     PairingMethod::Greedy => Pairing::Greedy,
@@ -934,6 +1023,9 @@ impl Pipeline {
             imesh_quad::QuadError::TooManyQuads { quads, .. } => {
                 self.too_many_elements(quads, "quads")
             }
+            imesh_quad::QuadError::LatticeTooFine { points, .. } => {
+                self.too_many_elements(points, "vertices")
+            }
             e => PipelineError::Quads(e),
         })?;
         seconds.quads = start.elapsed().as_secs_f64() - seconds.curves;
@@ -942,6 +1034,7 @@ impl Pipeline {
         seconds.adaptation = r.seconds.adaptation;
         counts.simplified_edges = simplified.graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
+        counts.dt_spacing = self.dt_spacing(&simplified.graph).unwrap_or(0.0);
         counts.refinement_points = r.dt.refinement.inserted;
         counts.unpaired_triangles = r.elements.unpaired;
         counts.damped_curves = r.adaptation.damped_curves;
@@ -1049,6 +1142,29 @@ impl Pipeline {
 
     /// The refinement's point cap: the user's, and never more than the element limit (every
     /// inserted point adds about two triangles).
+    /// The spacing of a uniform DT' over G', if the size asks for one.
+    fn dt_spacing(&self, g: &imesh_curves::CurveGraph) -> Option<f64> {
+        let o = &self.options;
+        match o.size {
+            ElementSize::Graded => None,
+            ElementSize::Pixels(px) => Some(2.0 * f64::from(o.template_level) * px),
+            ElementSize::Auto => {
+                let mut lengths: Vec<f64> = g
+                    .edges()
+                    .iter()
+                    .map(|e| {
+                        g.point(e.ends[0])
+                            .distance_squared(g.point(e.ends[1]))
+                            .sqrt()
+                    })
+                    .collect();
+                lengths.sort_by(f64::total_cmp);
+                let quartile = lengths.get(3 * lengths.len() / 4).copied().unwrap_or(0.0);
+                Some(quartile.max(MIN_AUTO_SPACING))
+            }
+        }
+    }
+
     fn refinement_cap(&self) -> usize {
         let o = &self.options;
         let limit = usize::try_from(o.max_elements).unwrap_or(usize::MAX);
@@ -1058,8 +1174,8 @@ impl Pipeline {
     fn too_many_elements(&self, at_least: u64, kind: &str) -> PipelineError {
         PipelineError::Limit(format!(
             "the mesh would have at least {at_least} {kind}, over the limit of {} elements: \
-             raise --max-elements, or give a larger --max-size, --tolerance or --te, or a lower \
-             --template-level",
+             raise --max-elements, or give a larger --size, --max-size, --tolerance or --te, or \
+             a lower --template-level",
             self.options.max_elements
         ))
     }

@@ -124,6 +124,15 @@ struct MeshFlags {
     /// equilateral one of this side.
     #[arg(long)]
     max_size: Option<f64>,
+    /// Quad size: graded (fine at the boundaries, coarse inside), a side in pixels (uniform:
+    /// a square lattice inside, higher shape-and-size), or auto (uniform, at the spacing the
+    /// simplified boundaries suggest) [default: graded].
+    #[arg(long)]
+    size: Option<imesh::ElementSize>,
+    /// Merge regions smaller than this many pixels into their neighbour before meshing
+    /// [default: 0, keep every region].
+    #[arg(long)]
+    min_region: Option<usize>,
     /// Curve simplification tolerance in pixels [default: 2].
     #[arg(long)]
     tolerance: Option<f64>,
@@ -252,6 +261,12 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(s) = args.max_size {
         o.max_size = Some(s);
+    }
+    if let Some(s) = args.size {
+        o.size = s;
+    }
+    if let Some(n) = args.min_region {
+        o.min_region = n;
     }
     if let Some(e) = args.elements {
         o.elements = e;

@@ -304,6 +304,15 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--template-level", "9"], "1 to 8"),
         (&["mesh", image, "--tolerance=-1"], "tolerance"),
         (&["mesh", image, "--pairing", "best"], "greedy or matching"),
+        (
+            &["mesh", image, "--size", "big"],
+            "auto, graded or a positive",
+        ),
+        (
+            &["mesh", image, "--size", "0"],
+            "auto, graded or a positive",
+        ),
+        (&["mesh", image, "-o", "m.msh", "--size", "0.01"], "--size"),
         (&["mesh", image, "--optimizer", "newton"], "local, global"),
         (
             &["mesh", image, "--metric", "jacobian"],

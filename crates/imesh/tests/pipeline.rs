@@ -2,7 +2,7 @@
 
 mod support;
 
-use imesh::{Elements, MeshOptions, PairingMethod, Pipeline};
+use imesh::{ElementSize, Elements, MeshOptions, PairingMethod, Pipeline};
 use support::degenerate_images;
 
 #[test]
@@ -21,6 +21,15 @@ fn degenerate_images_give_valid_all_quad_meshes() {
         MeshOptions {
             tolerance: 15.0,
             max_size: Some(3.0),
+            ..Default::default()
+        },
+        MeshOptions {
+            size: ElementSize::Pixels(1.5),
+            ..Default::default()
+        },
+        MeshOptions {
+            size: ElementSize::Auto,
+            min_region: 4,
             ..Default::default()
         },
     ];
@@ -98,4 +107,41 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             path.display()
         );
     }
+}
+
+/// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
+/// `min_region` merges the small regions away, saying how many pixels changed.
+#[test]
+fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
+    let path = support::fixtures()
+        .into_iter()
+        .find(|p| p.ends_with("matplotlib-s1045_mri.png"))
+        .expect("the MRI fixture");
+    let run = |options: MeshOptions| Pipeline::new(options).run_path(&path).unwrap().report;
+    let graded = run(MeshOptions::default());
+    let uniform = run(MeshOptions {
+        size: ElementSize::Pixels(3.0),
+        ..Default::default()
+    });
+    let cleaned = run(MeshOptions {
+        size: ElementSize::Pixels(3.0),
+        min_region: 50,
+        ..Default::default()
+    });
+    for r in [&graded, &uniform, &cleaned] {
+        assert!(r.validation.valid && r.quality.scaled_jacobian().min > 0.0);
+    }
+    let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
+    eprintln!(
+        "mean shape-and-size: graded {:.3}, size 3 {:.3}, size 3 + min region 50 {:.3}",
+        mean(&graded),
+        mean(&uniform),
+        mean(&cleaned)
+    );
+    assert!(mean(&uniform) > mean(&graded) + 0.2);
+    assert!(mean(&cleaned) > mean(&uniform) + 0.1);
+    assert_eq!(graded.counts.dt_spacing, 0.0);
+    assert_eq!(uniform.counts.dt_spacing, 6.0);
+    assert_eq!(uniform.counts.merged_pixels, 0);
+    assert!(cleaned.counts.merged_pixels > 0);
 }

@@ -8,7 +8,7 @@ mod support;
 use std::str::FromStr;
 use std::sync::OnceLock;
 
-use imesh::{Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline};
+use imesh::{ElementSize, Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline};
 use imesh_classify::{classify, Classifier, ClassifyOptions, LabelGrid};
 use proptest::prelude::*;
 
@@ -64,10 +64,30 @@ fn options() -> impl Strategy<Value = MeshOptions> {
             OptimizerMethod::None,
         ]),
         prop::sample::select(vec![Elements::Quad, Elements::Quad, Elements::Tri]),
+        prop::sample::select(vec![
+            ElementSize::Graded,
+            ElementSize::Auto,
+            ElementSize::Pixels(1.0),
+            ElementSize::Pixels(4.0),
+        ]),
+        prop::sample::select(vec![0usize, 0, 30]),
     )
         .prop_map(
-            |(te, tolerance, min_angle, max_size, level, pairing, optimizer, elements)| {
+            |(
+                te,
+                tolerance,
+                min_angle,
+                max_size,
+                level,
+                pairing,
+                optimizer,
+                elements,
+                size,
+                min_region,
+            )| {
                 MeshOptions {
+                    size,
+                    min_region,
                     te,
                     tolerance,
                     min_angle,

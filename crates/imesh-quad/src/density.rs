@@ -1,0 +1,229 @@
+//! A uniform DT': boundary pieces and an inside lattice of one spacing (DESIGN.md §2, step 6).
+//!
+//! Shape-and-size compares every quad with the mesh's mean quad area, so a DT' graded from short
+//! boundary pieces to a coarse inside scores low however well shaped its elements are. Here every
+//! boundary is split into pieces of about one spacing, and the inside is filled with an
+//! axis-aligned square lattice of that spacing, kept clear of the boundaries. Pairing joins the
+//! lattice's triangles back into its squares (their diagonal is their longest edge), which the
+//! templates cut into squares: the inside becomes a grid of equal squares, and only a band along
+//! the boundaries is left to refinement.
+
+use imesh_curves::segment_distance;
+use imesh_geom::{GeomError, Point, Triangulation};
+
+/// How far a lattice point stays from every boundary piece, in spacings: nearer, it would make a
+/// thin triangle with the piece; farther, the band it leaves needs more refinement.
+pub const CLEARANCE: f64 = 0.6;
+
+/// Puts the points of a uniform DT' of `spacing` into `t` (a labelled triangulation whose hull is
+/// an axis-aligned rectangle and whose segments are the boundaries), and returns how many were
+/// inserted:
+///
+/// 1. the lattice points on the domain border that are clear of every other boundary (they
+///    split the border segments, so that the lattice meets the border square on);
+/// 2. equal splits of every segment piece still longer than `spacing`;
+/// 3. the lattice points inside that are clear of every segment piece.
+///
+/// The lattice's spacing along x and y is the nearest that divides the domain's width and height.
+///
+/// ```
+/// use imesh_geom::{Point, Triangulation};
+/// use imesh_quad::uniform_points;
+/// let corners = [Point::new(0.0, 0.0), Point::new(12.0, 0.0), Point::new(12.0, 8.0), Point::new(0.0, 8.0)];
+/// let (mut t, v) = Triangulation::from_points(&corners).unwrap();
+/// for k in 0..4 {
+///     t.insert_segment(v[k], v[(k + 1) % 4]).unwrap();
+/// }
+/// t.set_labels(|_| 0);
+/// // A 12 × 8 rectangle at spacing 2: a 7 × 5 lattice, all of it.
+/// assert_eq!(uniform_points(&mut t, 2.0).unwrap(), 7 * 5 - 4);
+/// assert_eq!(t.num_triangles(), 2 * 6 * 4);
+/// t.check().unwrap();
+/// ```
+///
+/// # Errors
+/// [`GeomError`] from an insertion (it cannot happen for a valid triangulation).
+pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, GeomError> {
+    let before = t.num_vertices();
+    if !(spacing.is_finite() && spacing > 0.0) || t.is_degenerate() {
+        return Ok(0);
+    }
+    let lattice = Lattice::new(t, spacing);
+    let reach = CLEARANCE * spacing;
+
+    // 1. The border.
+    let grid = EdgeGrid::new(t, &lattice, reach);
+    let mut border = Vec::new();
+    for (i, j) in lattice.border() {
+        let p = lattice.point(i, j);
+        let clear = grid.clear(p, reach, |[a, b]| {
+            // A piece of the same border side counts by its ends only: the point lies on it.
+            let side = |q: Point| {
+                (q.x == p.x && (p.x == lattice.lo.x || p.x == lattice.hi.x))
+                    || (q.y == p.y && (p.y == lattice.lo.y || p.y == lattice.hi.y))
+            };
+            if side(a) && side(b) {
+                a.distance_squared(p).min(b.distance_squared(p)).sqrt()
+            } else {
+                segment_distance(a, b, p)
+            }
+        });
+        if clear {
+            border.push(p);
+        }
+    }
+    for p in border {
+        t.insert(p)?;
+    }
+
+    // 2. The boundaries.
+    t.split_long_segments(spacing)?;
+
+    // 3. The inside.
+    let grid = EdgeGrid::new(t, &lattice, reach);
+    for j in 1..lattice.n[1] {
+        for i in 1..lattice.n[0] {
+            let p = lattice.point(i, j);
+            if grid.clear(p, reach, |[a, b]| segment_distance(a, b, p)) {
+                t.insert(p)?;
+            }
+        }
+    }
+    Ok(t.num_vertices() - before)
+}
+
+/// How many points the lattice of `spacing` has over the bounding box of `t`'s points (at
+/// most; those near boundaries are left out), saturating.
+pub(crate) fn lattice_points(t: &Triangulation, spacing: f64) -> u64 {
+    if !(spacing.is_finite() && spacing > 0.0) || t.num_vertices() == 0 {
+        return 0;
+    }
+    let (lo, hi) = bounds(t);
+    let along = |extent: f64| (extent / spacing).round().max(1.0) + 1.0;
+    (along(hi.x - lo.x) * along(hi.y - lo.y)).min(u64::MAX as f64) as u64
+}
+
+/// The bounding box of the triangulation's points.
+fn bounds(t: &Triangulation) -> (Point, Point) {
+    let (mut lo, mut hi) = (t.points()[0], t.points()[0]);
+    for p in t.points() {
+        lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    (lo, hi)
+}
+
+/// The square lattice over the domain's bounding box.
+struct Lattice {
+    lo: Point,
+    hi: Point,
+    /// Cells along x and y.
+    n: [usize; 2],
+    /// Spacing along x and y.
+    step: [f64; 2],
+}
+
+impl Lattice {
+    fn new(t: &Triangulation, spacing: f64) -> Self {
+        let (lo, hi) = bounds(t);
+        let cells = |extent: f64| (extent / spacing).round().clamp(1.0, 1e7) as usize;
+        let n = [cells(hi.x - lo.x), cells(hi.y - lo.y)];
+        Self {
+            lo,
+            hi,
+            n,
+            step: [(hi.x - lo.x) / n[0] as f64, (hi.y - lo.y) / n[1] as f64],
+        }
+    }
+
+    /// Lattice point (i, j); the last row and column land exactly on the far border.
+    fn point(&self, i: usize, j: usize) -> Point {
+        let along = |k: usize, n: usize, lo: f64, hi: f64, step: f64| {
+            if k == n {
+                hi
+            } else {
+                lo + k as f64 * step
+            }
+        };
+        Point::new(
+            along(i, self.n[0], self.lo.x, self.hi.x, self.step[0]),
+            along(j, self.n[1], self.lo.y, self.hi.y, self.step[1]),
+        )
+    }
+
+    /// The lattice points on the border, corners excepted.
+    fn border(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let [nx, ny] = self.n;
+        let rows = (1..nx).flat_map(move |i| [(i, 0), (i, ny)]);
+        let columns = (1..ny).flat_map(move |j| [(0, j), (nx, j)]);
+        rows.chain(columns)
+    }
+
+    /// The cell of `p`, clamped to the lattice.
+    fn cell(&self, p: Point) -> (usize, usize) {
+        let along = |v: f64, lo: f64, step: f64, n: usize| {
+            (((v - lo) / step).floor().max(0.0) as usize).min(n - 1)
+        };
+        (
+            along(p.x, self.lo.x, self.step[0], self.n[0]),
+            along(p.y, self.lo.y, self.step[1], self.n[1]),
+        )
+    }
+}
+
+/// The triangulation's segment pieces, bucketed by the lattice cells within `reach` of them.
+struct EdgeGrid<'a> {
+    lattice: &'a Lattice,
+    edges: Vec<[Point; 2]>,
+    /// For each cell (row-major), the pieces that come within `reach` of it.
+    cells: Vec<Vec<u32>>,
+}
+
+impl<'a> EdgeGrid<'a> {
+    fn new(t: &Triangulation, lattice: &'a Lattice, reach: f64) -> Self {
+        let edges: Vec<[Point; 2]> = t
+            .constrained_edges()
+            .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
+            .collect();
+        let [nx, ny] = lattice.n;
+        let mut cells = vec![Vec::new(); nx * ny];
+        let spacing = lattice.step[0].max(lattice.step[1]);
+        for (k, &[a, b]) in edges.iter().enumerate() {
+            // A long piece is registered a spacing-long stretch at a time, so that it lands only
+            // in the cells along it.
+            let stretches = (a.distance_squared(b).sqrt() / spacing).ceil().max(1.0) as usize;
+            for s in 0..stretches {
+                let (f0, f1) = (
+                    s as f64 / stretches as f64,
+                    (s + 1) as f64 / stretches as f64,
+                );
+                let (p, q) = (a + (b - a) * f0, a + (b - a) * f1);
+                let (i0, j0) = lattice.cell(Point::new(p.x.min(q.x) - reach, p.y.min(q.y) - reach));
+                let (i1, j1) = lattice.cell(Point::new(p.x.max(q.x) + reach, p.y.max(q.y) + reach));
+                for j in j0..=j1 {
+                    for i in i0..=i1 {
+                        let c = &mut cells[j * nx + i];
+                        if c.last() != Some(&(k as u32)) {
+                            c.push(k as u32);
+                        }
+                    }
+                }
+            }
+        }
+        Self {
+            lattice,
+            edges,
+            cells,
+        }
+    }
+
+    /// True when every piece near `p` is at least `reach` away by `distance`.
+    fn clear(&self, p: Point, reach: f64, distance: impl Fn([Point; 2]) -> f64) -> bool {
+        // Pieces were bucketed by the same cell function over their reach, so the cell of `p`
+        // holds every piece within reach of it.
+        let (i, j) = self.lattice.cell(p);
+        self.cells[j * self.lattice.n[0] + i]
+            .iter()
+            .all(|&k| distance(self.edges[k as usize]) >= reach)
+    }
+}
