@@ -7,7 +7,9 @@
 
 #![allow(dead_code)]
 
-use imesh::{Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline, PipelineError};
+use imesh::{
+    ElementSize, Elements, MeshOptions, OptimizerMethod, PairingMethod, Pipeline, PipelineError,
+};
 use imesh_classify::{LabelGrid, Region};
 use imesh_curves::{segment_distance, CurveGraph, SimplifyOptions};
 use imesh_geom::{
@@ -400,6 +402,15 @@ pub fn pipeline(data: &[u8]) {
     // The global optimiser is the paper's single Powell run, slow by design (seconds on a few
     // hundred quads under the sanitizer): only on the smallest images.
     let mut options = options;
+    // Drawn after the grid, so that the saved inputs from before these options replay the same
+    // grids (an exhausted input picks the first choice).
+    options.size = b.pick(&[
+        ElementSize::Graded,
+        ElementSize::Auto,
+        ElementSize::Pixels(1.0),
+        ElementSize::Pixels(2.5),
+    ]);
+    options.min_region = b.pick(&[0, 3, 12]);
     if options.optimizer == OptimizerMethod::Global && grid.width() * grid.height() > 64 {
         options.optimizer = OptimizerMethod::Local;
     }
