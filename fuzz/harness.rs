@@ -411,6 +411,7 @@ pub fn pipeline(data: &[u8]) {
         ElementSize::Pixels(2.5),
     ]);
     options.min_region = b.pick(&[0, 3, 12]);
+    options.majority = b.pick(&[0, 0, 1, 2]);
     if options.optimizer == OptimizerMethod::Global && grid.width() * grid.height() > 64 {
         options.optimizer = OptimizerMethod::Local;
     }

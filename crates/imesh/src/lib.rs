@@ -80,6 +80,9 @@ pub enum ElementSize {
     Graded,
 }
 
+/// Largest [`MeshOptions::majority`] radius: the filter costs (2R+1)² per pixel.
+pub const MAX_MAJORITY: u32 = 8;
+
 /// Smallest DT' spacing `--size auto` chooses, in pixels: finer boundaries than this are met by
 /// refinement, not by a finer lattice everywhere.
 pub const MIN_AUTO_SPACING: f64 = 4.0;
@@ -221,6 +224,10 @@ pub struct MeshOptions {
     /// Regions (4-connected) smaller than this many pixels are merged into the neighbour they
     /// share the longest border with before meshing (0: every region is kept).
     pub min_region: usize,
+    /// Radius of a majority filter applied to the labels before meshing (0: none): every pixel
+    /// takes the label most common in its (2R+1)² window, which removes specks, notches and
+    /// strips thinner than about R pixels.
+    pub majority: u32,
     /// Curve simplification tolerance in pixels (quads).
     pub tolerance: f64,
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² (1–8).
@@ -260,6 +267,7 @@ impl Default for MeshOptions {
             max_size: None,
             size: ElementSize::Graded,
             min_region: 0,
+            majority: 0,
             tolerance: imesh_curves::DEFAULT_TOLERANCE,
             template_level: 1,
             pairing: PairingMethod::Matching,
@@ -340,9 +348,9 @@ pub struct Counts {
     pub height: u32,
     /// Labels in the label grid.
     pub labels: usize,
-    /// Pixels whose small region `min_region` merged into a neighbour (label agreement is
-    /// measured against the merged grid).
-    pub merged_pixels: usize,
+    /// Pixels whose label the clean-up (`majority`, `min_region`) changed; label agreement is
+    /// measured against the cleaned grid.
+    pub cleaned_pixels: usize,
     /// Pixel centres Imesh sampled.
     pub sampled_vertices: usize,
     /// c-edges of the partition.
@@ -751,23 +759,10 @@ impl Pipeline {
         self.check_options()?;
         self.check_size(grid.width(), grid.height())?;
         let start = Instant::now();
-        let cleaned;
-        let mut merged_pixels = 0;
-        let grid = if o.min_region > 1 {
-            cleaned = imesh_classify::remove_small_regions(grid, o.min_region);
-            // Labels are renumbered when regions vanish: compare by region name.
-            fn name(g: &LabelGrid, l: u32) -> Option<&str> {
-                g.regions().get(l as usize).map(|r| r.name.as_str())
-            }
-            merged_pixels = grid
-                .labels()
-                .iter()
-                .zip(cleaned.labels())
-                .filter(|&(&a, &b)| name(grid, a) != name(&cleaned, b))
-                .count();
-            &cleaned
-        } else {
-            grid
+        let cleaned = self.clean_up(grid);
+        let (grid, cleaned_pixels) = match &cleaned {
+            Some((g, changed)) => (g, *changed),
+            None => (grid, 0),
         };
         self.stage(Stage::Sample);
         let mut segmented = SegmentedMesh::from_grid(
@@ -789,7 +784,7 @@ impl Pipeline {
             labels: grid.num_labels(),
             sampled_vertices: segmented.inserted,
             c_edges: segmented.c_edges.len(),
-            merged_pixels,
+            cleaned_pixels,
             ..Default::default()
         };
         let mut pictures = Pictures {
@@ -1142,6 +1137,33 @@ impl Pipeline {
 
     /// The refinement's point cap: the user's, and never more than the element limit (every
     /// inserted point adds about two triangles).
+    /// The label grid after the clean-up the options ask for (a majority filter, then merging
+    /// small regions), with the number of pixels whose label changed; `None` without clean-up.
+    fn clean_up(&self, grid: &LabelGrid) -> Option<(LabelGrid, usize)> {
+        let o = &self.options;
+        if o.majority == 0 && o.min_region <= 1 {
+            return None;
+        }
+        let mut cleaned = grid.clone();
+        if o.majority > 0 {
+            cleaned = imesh_classify::majority_filter(&cleaned, o.majority, 1);
+        }
+        if o.min_region > 1 {
+            cleaned = imesh_classify::remove_small_regions(&cleaned, o.min_region);
+        }
+        // Labels are renumbered when regions vanish: compare by region name.
+        fn name(g: &LabelGrid, l: u32) -> Option<&str> {
+            g.regions().get(l as usize).map(|r| r.name.as_str())
+        }
+        let changed = grid
+            .labels()
+            .iter()
+            .zip(cleaned.labels())
+            .filter(|&(&a, &b)| name(grid, a) != name(&cleaned, b))
+            .count();
+        Some((cleaned, changed))
+    }
+
     /// The spacing of a uniform DT' over G', if the size asks for one.
     fn dt_spacing(&self, g: &imesh_curves::CurveGraph) -> Option<f64> {
         let o = &self.options;
@@ -1206,6 +1228,13 @@ impl Pipeline {
             return Err(PipelineError::Options(format!(
                 "template level {} is out of range: give 1 to 8",
                 o.template_level
+            )));
+        }
+        if o.majority > MAX_MAJORITY {
+            return Err(PipelineError::Options(format!(
+                "the majority filter radius {} is too large: give 0 to {MAX_MAJORITY} pixels \
+                 (use --min-region for larger specks)",
+                o.majority
             )));
         }
         if !(o.tolerance.is_finite() && o.tolerance >= 0.0) {

@@ -133,6 +133,10 @@ struct MeshFlags {
     /// [default: 0, keep every region].
     #[arg(long)]
     min_region: Option<usize>,
+    /// Majority filter of this radius over the labels before meshing: removes specks, notches
+    /// and strips thinner than about the radius [default: 0, none].
+    #[arg(long)]
+    majority: Option<u32>,
     /// Curve simplification tolerance in pixels [default: 2].
     #[arg(long)]
     tolerance: Option<f64>,
@@ -267,6 +271,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(n) = args.min_region {
         o.min_region = n;
+    }
+    if let Some(r) = args.majority {
+        o.majority = r;
     }
     if let Some(e) = args.elements {
         o.elements = e;

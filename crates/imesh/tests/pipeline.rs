@@ -30,6 +30,7 @@ fn degenerate_images_give_valid_all_quad_meshes() {
         MeshOptions {
             size: ElementSize::Auto,
             min_region: 4,
+            majority: 1,
             ..Default::default()
         },
     ];
@@ -110,7 +111,8 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
-/// `min_region` merges the small regions away, saying how many pixels changed.
+/// `min_region` merges the small regions away and `majority` smooths the labels first, each
+/// saying how many pixels changed.
 #[test]
 fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
     let path = support::fixtures()
@@ -128,20 +130,29 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         min_region: 50,
         ..Default::default()
     });
-    for r in [&graded, &uniform, &cleaned] {
+    let smoothed = run(MeshOptions {
+        size: ElementSize::Pixels(3.0),
+        min_region: 50,
+        majority: 2,
+        ..Default::default()
+    });
+    for r in [&graded, &uniform, &cleaned, &smoothed] {
         assert!(r.validation.valid && r.quality.scaled_jacobian().min > 0.0);
     }
     let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
     eprintln!(
-        "mean shape-and-size: graded {:.3}, size 3 {:.3}, size 3 + min region 50 {:.3}",
+        "mean shape-and-size: graded {:.3}, size 3 {:.3}, + min region 50 {:.3}, + majority 2 {:.3}",
         mean(&graded),
         mean(&uniform),
-        mean(&cleaned)
+        mean(&cleaned),
+        mean(&smoothed)
     );
     assert!(mean(&uniform) > mean(&graded) + 0.2);
     assert!(mean(&cleaned) > mean(&uniform) + 0.1);
     assert_eq!(graded.counts.dt_spacing, 0.0);
     assert_eq!(uniform.counts.dt_spacing, 6.0);
-    assert_eq!(uniform.counts.merged_pixels, 0);
-    assert!(cleaned.counts.merged_pixels > 0);
+    assert_eq!(uniform.counts.cleaned_pixels, 0);
+    assert!(cleaned.counts.cleaned_pixels > 0);
+    assert!(mean(&smoothed) > mean(&cleaned) + 0.05);
+    assert!(smoothed.counts.cleaned_pixels > cleaned.counts.cleaned_pixels);
 }

@@ -70,7 +70,7 @@ fn options() -> impl Strategy<Value = MeshOptions> {
             ElementSize::Pixels(1.0),
             ElementSize::Pixels(4.0),
         ]),
-        prop::sample::select(vec![0usize, 0, 30]),
+        prop::sample::select(vec![(0usize, 0u32), (0, 0), (30, 0), (0, 2), (20, 1)]),
     )
         .prop_map(
             |(
@@ -83,11 +83,12 @@ fn options() -> impl Strategy<Value = MeshOptions> {
                 optimizer,
                 elements,
                 size,
-                min_region,
+                (min_region, majority),
             )| {
                 MeshOptions {
                     size,
                     min_region,
+                    majority,
                     te,
                     tolerance,
                     min_angle,
