@@ -185,8 +185,55 @@ fn densities() -> [(&'static str, MeshOptions); 3] {
     ]
 }
 
-/// Runs the three experiments; `scaling_max` is the largest side of the scaling series.
-pub fn run(scaling_max: u32) -> Result<(), String> {
+/// The uniform-size options of the second table: quads about 3 px wide, specks under 50 px
+/// merged and the labels smoothed by a radius-2 majority filter first.
+fn uniform() -> MeshOptions {
+    MeshOptions {
+        size: imesh::ElementSize::Pixels(3.0),
+        min_region: 50,
+        majority: 2,
+        ..MeshOptions::default()
+    }
+}
+
+/// Where `--readme` puts the tables in README.md.
+const README_BEGIN: &str = "<!-- cargo xtask bench pipeline --readme: begin -->";
+const README_END: &str = "<!-- cargo xtask bench pipeline --readme: end -->";
+
+/// `text` (the README) with the text between its markers replaced by `tables`.
+fn fill_block(text: &str, tables: &str) -> Result<String, String> {
+    let (Some(begin), Some(end)) = (text.find(README_BEGIN), text.find(README_END)) else {
+        return Err(format!(
+            "README.md has no '{README_BEGIN}' … '{README_END}' block to fill"
+        ));
+    };
+    if end < begin {
+        return Err("README.md's bench markers are in the wrong order".into());
+    }
+    Ok(format!(
+        "{}{README_BEGIN}\n{}\n{}",
+        &text[..begin],
+        tables.trim(),
+        &text[end..]
+    ))
+}
+
+/// Replaces the README's results block by `tables`, whole or not at all (a temporary file
+/// renamed over it).
+fn write_readme(tables: &str) -> Result<(), String> {
+    let path = fixtures_dir().join("../../README.md");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read README.md: {e}"))?;
+    let updated = fill_block(&text, tables)?;
+    let tmp = path.with_extension("md.tmp");
+    std::fs::write(&tmp, updated).map_err(|e| format!("cannot write README.md: {e}"))?;
+    std::fs::rename(&tmp, &path).map_err(|e| format!("cannot replace README.md: {e}"))?;
+    println!("README.md: results section regenerated");
+    Ok(())
+}
+
+/// Runs the experiments; `scaling_max` is the largest side of the scaling series; `readme`
+/// also writes the tables into README.md's results section.
+pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
     let mut markdown = String::new();
     let mut table = |title: &str, rows: &[Row]| {
         let text = format!(
@@ -204,7 +251,7 @@ pub fn run(scaling_max: u32) -> Result<(), String> {
         .filter(|p| p.extension().is_some_and(|e| e == "png"))
         .collect();
     paths.sort();
-    let mut fixtures = Vec::new();
+    let (mut fixtures, mut uniform_fixtures) = (Vec::new(), Vec::new());
     for path in &paths {
         let image = imesh_classify::load_image(path, imesh_classify::DEFAULT_MAX_PIXELS)
             .map_err(|e| e.to_string())?;
@@ -212,10 +259,15 @@ pub fn run(scaling_max: u32) -> Result<(), String> {
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         fixtures.push(measure(&name, &image, &MeshOptions::default())?);
+        uniform_fixtures.push(measure(&name, &image, &uniform())?);
     }
     table(
         "Every fixture, default options (the paper's Table I)",
         &fixtures,
+    );
+    table(
+        "Every fixture, uniform size: --size 3 --min-region 50 --majority 2",
+        &uniform_fixtures,
     );
 
     let mri = imesh_classify::load_image(
@@ -276,6 +328,7 @@ pub fn run(scaling_max: u32) -> Result<(), String> {
     let dir = crate::bench_dir()?;
     let json = serde_json::json!({
         "fixtures": fixtures,
+        "uniform": uniform_fixtures,
         "densities": density,
         "scaling": scaling,
     });
@@ -284,8 +337,31 @@ pub fn run(scaling_max: u32) -> Result<(), String> {
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
     )
     .map_err(|e| format!("cannot write pipeline.json: {e}"))?;
-    std::fs::write(dir.join("pipeline.md"), markdown)
+    std::fs::write(dir.join("pipeline.md"), &markdown)
         .map_err(|e| format!("cannot write pipeline.md: {e}"))?;
     println!("written: {0}/pipeline.md, {0}/pipeline.json", dir.display());
+    if readme {
+        write_readme(&markdown)?;
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_readme_block_is_replaced_and_the_rest_kept() {
+        let text = format!("# T\n\nbefore\n{README_BEGIN}\nold table\n{README_END}\nafter\n");
+        let filled = fill_block(&text, "\n| new |\n").unwrap();
+        assert_eq!(
+            filled,
+            format!("# T\n\nbefore\n{README_BEGIN}\n| new |\n{README_END}\nafter\n")
+        );
+        // Filling again gives the same text: the block is found by its markers, not its contents.
+        assert_eq!(fill_block(&filled, "| new |").unwrap(), filled);
+        assert!(fill_block("no markers", "x").is_err());
+        let swapped = format!("{README_END}\n{README_BEGIN}");
+        assert!(fill_block(&swapped, "x").is_err());
+    }
 }

@@ -4,7 +4,7 @@
 //! cargo xtask bench delaunay [--runs N] [--quick]
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
-//! cargo xtask bench pipeline [--scaling-max SIDE]
+//! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
 //! cargo xtask compare gmsh
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -24,7 +24,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
-       cargo xtask bench pipeline [--scaling-max SIDE]
+       cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
        cargo xtask compare gmsh
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -44,10 +44,12 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
     --global-iterations N   Powell iterations of the global mode (default 10)
 
   bench pipeline   the whole run on every fixture as the paper's Table I (counts, seconds per
-                   stage, quality), one image at three densities (Figure 8 / Table II), and the
+                   stage, quality), again at a uniform size (--size 3 --min-region 50
+                   --majority 2), one image at three densities (Figure 8 / Table II), and the
                    camera fixture resized 256² … 4096² (seconds and peak heap per stage);
                    writes target/bench/pipeline.md and pipeline.json
     --scaling-max SIDE   largest side of the scaling series (default 4096)
+    --readme             also write the tables into README.md's results section
 
   compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
                    same simplified boundaries of five fixtures at about the same quad count,
@@ -111,12 +113,18 @@ fn run(args: &[String]) -> Result<(), String> {
             bench_optim::run(iterations)
         }
         ["bench", "pipeline", rest @ ..] => {
-            let side = match rest {
-                [] => 4096,
-                [flag @ "--scaling-max", n] => positive(flag, Some(n))?,
-                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
-            };
-            bench_pipeline::run(side)
+            let (mut side, mut readme, mut rest) = (4096, false, rest);
+            loop {
+                match rest {
+                    [] => break,
+                    ["--readme", more @ ..] => (readme, rest) = (true, more),
+                    [flag @ "--scaling-max", n, more @ ..] => {
+                        (side, rest) = (positive(flag, Some(n))?, more);
+                    }
+                    _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+                }
+            }
+            bench_pipeline::run(side, readme)
         }
         ["compare", "gmsh"] => compare_gmsh::run(),
         ["fixtures", "quality"] => fixtures::quality(),
