@@ -9,20 +9,21 @@
 //! the boundaries is left to refinement.
 
 use imesh_curves::segment_distance;
-use imesh_geom::{GeomError, Point, Triangulation};
+use imesh_geom::{GeomError, Location, Point, Triangulation, EXTERIOR};
 
 /// How far a lattice point stays from every boundary piece, in spacings: nearer, it would make a
 /// thin triangle with the piece; farther, the band it leaves needs more refinement.
 pub const CLEARANCE: f64 = 0.6;
 
-/// Puts the points of a uniform DT' of `spacing` into `t` (a labelled triangulation whose hull is
-/// an axis-aligned rectangle and whose segments are the boundaries), and returns how many were
-/// inserted:
+/// Puts the points of a uniform DT' of `spacing` into `t` (a labelled triangulation whose
+/// segments are the boundaries, its hull usually an axis-aligned rectangle), and returns how
+/// many were inserted:
 ///
-/// 1. the lattice points on the domain border that are clear of every other boundary (they
-///    split the border segments, so that the lattice meets the border square on);
+/// 1. the lattice points on the hull that are clear of every other boundary (they split the
+///    border segments, so that the lattice meets the border square on);
 /// 2. equal splits of every segment piece still longer than `spacing`;
-/// 3. the lattice points inside that are clear of every segment piece.
+/// 3. the lattice points inside the domain (within the hull, not in an [`EXTERIOR`] hole of a
+///    labelled triangulation) that are clear of every segment piece.
 ///
 /// The lattice's spacing along x and y is the nearest that divides the domain's width and height.
 ///
@@ -68,7 +69,12 @@ pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, Geom
                 segment_distance(a, b, p)
             }
         });
-        if clear {
+        // Only on the hull itself: a domain that is not the full rectangle keeps its shape.
+        let on_hull = match t.locate(p) {
+            Location::OnEdge(h) => t.neighbour(h).is_none() || t.neighbour(t.twin(h)).is_none(),
+            _ => false,
+        };
+        if clear && on_hull {
             border.push(p);
         }
     }
@@ -81,15 +87,27 @@ pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, Geom
 
     // 3. The inside.
     let grid = EdgeGrid::new(t, &lattice, reach);
+    let labelled = t.triangles().any(|f| t.label(f) != EXTERIOR);
     for j in 1..lattice.n[1] {
         for i in 1..lattice.n[0] {
             let p = lattice.point(i, j);
-            if grid.clear(p, reach, |[a, b]| segment_distance(a, b, p)) {
+            if grid.clear(p, reach, |[a, b]| segment_distance(a, b, p)) && inside(t, p, labelled) {
                 t.insert(p)?;
             }
         }
     }
     Ok(t.num_vertices() - before)
+}
+
+/// True when `p` lies in the domain: inside the hull, and not in a triangle labelled
+/// [`EXTERIOR`] (a hole) unless no triangle has a label (then, as for refinement, all are in).
+fn inside(t: &Triangulation, p: Point, labelled: bool) -> bool {
+    let labelled_in = |f| !labelled || t.label(f) != EXTERIOR;
+    match t.locate(p) {
+        Location::InTriangle(f) => labelled_in(f),
+        Location::OnEdge(h) => labelled_in(t.triangle_of(h)),
+        Location::OnVertex(_) | Location::OutsideHull(_) | Location::NoTriangles => false,
+    }
 }
 
 /// How many points the lattice of `spacing` has over the bounding box of `t`'s points (at
@@ -225,5 +243,55 @@ impl<'a> EdgeGrid<'a> {
         self.cells[j * self.lattice.n[0] + i]
             .iter()
             .all(|&k| distance(self.edges[k as usize]) >= reach)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A domain that is not its bounding rectangle (a right triangle with a square hole labelled
+    /// [`EXTERIOR`]): no point lands outside the hull or in the hole, the hull keeps its area, and
+    /// the inside still gets lattice points.
+    #[test]
+    fn a_non_rectangular_domain_keeps_its_shape() {
+        let corners = [
+            Point::new(0.0, 0.0),
+            Point::new(30.0, 0.0),
+            Point::new(0.0, 30.0),
+            Point::new(4.0, 4.0),
+            Point::new(10.0, 4.0),
+            Point::new(10.0, 10.0),
+            Point::new(4.0, 10.0),
+        ];
+        let (mut t, v) = Triangulation::from_points(&corners).unwrap();
+        for (a, b) in [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (6, 3)] {
+            t.insert_segment(v[a], v[b]).unwrap();
+        }
+        t.label_regions(&[(Point::new(15.0, 5.0), 1), (Point::new(7.0, 7.0), EXTERIOR)]);
+        let area = |t: &Triangulation| t.triangles().map(|f| t.signed_area(f)).sum::<f64>();
+        let before = area(&t);
+        let inserted = uniform_points(&mut t, 2.0).unwrap();
+        assert!(inserted > 20, "{inserted} points");
+        t.check().unwrap();
+        assert!((area(&t) - before).abs() < 1e-9 * before);
+        // Unlabelled, the same domain is filled everywhere inside the hull, hole included.
+        let (mut u, w) = Triangulation::from_points(&corners).unwrap();
+        for (a, b) in [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (6, 3)] {
+            u.insert_segment(w[a], w[b]).unwrap();
+        }
+        uniform_points(&mut u, 2.0).unwrap();
+        assert!(u
+            .points()
+            .iter()
+            .any(|p| p.x > 4.0 && p.x < 10.0 && p.y > 4.0 && p.y < 10.0));
+        for p in t.points() {
+            assert!(
+                p.x >= 0.0 && p.y >= 0.0 && p.x + p.y <= 30.0 + 1e-9,
+                "{p:?} off the hull"
+            );
+            let in_hole = p.x > 4.0 && p.x < 10.0 && p.y > 4.0 && p.y < 10.0;
+            assert!(!in_hole, "{p:?} in the hole");
+        }
     }
 }
