@@ -264,10 +264,14 @@ mod tests {
             Point::new(10.0, 10.0),
             Point::new(4.0, 10.0),
         ];
-        let (mut t, v) = Triangulation::from_points(&corners).unwrap();
-        for (a, b) in [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (6, 3)] {
-            t.insert_segment(v[a], v[b]).unwrap();
-        }
+        let domain = || {
+            let (mut t, v) = Triangulation::from_points(&corners).unwrap();
+            for (a, b) in [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (6, 3)] {
+                t.insert_segment(v[a], v[b]).unwrap();
+            }
+            t
+        };
+        let mut t = domain();
         t.label_regions(&[(Point::new(15.0, 5.0), 1), (Point::new(7.0, 7.0), EXTERIOR)]);
         let area = |t: &Triangulation| t.triangles().map(|f| t.signed_area(f)).sum::<f64>();
         let before = area(&t);
@@ -276,10 +280,7 @@ mod tests {
         t.check().unwrap();
         assert!((area(&t) - before).abs() < 1e-9 * before);
         // Unlabelled, the same domain is filled everywhere inside the hull, hole included.
-        let (mut u, w) = Triangulation::from_points(&corners).unwrap();
-        for (a, b) in [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (6, 3)] {
-            u.insert_segment(w[a], w[b]).unwrap();
-        }
+        let mut u = domain();
         uniform_points(&mut u, 2.0).unwrap();
         assert!(u
             .points()
