@@ -129,8 +129,9 @@ fn cell(s: &Option<Side>, ours: &Side) -> String {
     }
 }
 
-/// Runs the comparison on the fixtures and writes `target/bench/compare-gmsh.json`.
-pub fn run() -> Result<(), String> {
+/// Runs the comparison on the fixtures with our `options` (Gmsh gets the same G' and a uniform
+/// size giving about our quad count) and writes `target/bench/compare-gmsh.json`.
+pub fn run(options: MeshOptions) -> Result<(), String> {
     let root = crate::fixtures::workspace_root()?;
     let python = crate::fixtures::venv_python(&root, "venv-gmsh", "import gmsh", GMSH)?;
     let mut rows = Vec::new();
@@ -139,10 +140,10 @@ pub fn run() -> Result<(), String> {
     for file in FIXTURES {
         let path = root.join("fixtures/images").join(file);
         // Our whole run, timed alone, then once more for G' (the stage pictures).
-        let ours = Pipeline::new(MeshOptions::default())
+        let ours = Pipeline::new(options.clone())
             .run_path(&path)
             .map_err(|e| format!("{file}: {e}"))?;
-        let staged = Pipeline::new(MeshOptions::default())
+        let staged = Pipeline::new(options.clone())
             .with_stages()
             .run_path(&path)
             .map_err(|e| format!("{file}: {e}"))?;

@@ -5,7 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-//! cargo xtask compare gmsh
+//! cargo xtask compare gmsh [--size auto|graded|PX]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
 //! ```
@@ -25,7 +25,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-       cargo xtask compare gmsh
+       cargo xtask compare gmsh [--size auto|graded|PX]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
 
@@ -55,6 +55,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    same simplified boundaries of five fixtures at about the same quad count,
                    both measured with our metrics; Gmsh from PyPI into target/venv-gmsh;
                    writes target/bench/compare-gmsh.json
+    --size S             our element size (auto, graded or pixels; default: graded)
 
   fixtures         regenerate everything under fixtures/ that this project derives, and say
                    what changed: points/disc-boundary.txt (a synthetic label boundary) and
@@ -126,7 +127,17 @@ fn run(args: &[String]) -> Result<(), String> {
             }
             bench_pipeline::run(side, readme)
         }
-        ["compare", "gmsh"] => compare_gmsh::run(),
+        ["compare", "gmsh", rest @ ..] => {
+            let options = match rest {
+                [] => imesh::MeshOptions::default(),
+                ["--size", size] => imesh::MeshOptions {
+                    size: size.parse()?,
+                    ..imesh::MeshOptions::default()
+                },
+                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+            };
+            compare_gmsh::run(options)
+        }
         ["fixtures", "quality"] => fixtures::quality(),
         ["fixtures", "points"] => fixtures::points(),
         ["fixtures"] => fixtures::all(),
