@@ -111,14 +111,13 @@ fn inside(t: &Triangulation, p: Point, labelled: bool) -> bool {
 }
 
 /// How many points the lattice of `spacing` has over the bounding box of `t`'s points (at
-/// most; those near boundaries are left out), saturating.
+/// most; those near boundaries are left out).
 pub(crate) fn lattice_points(t: &Triangulation, spacing: f64) -> u64 {
     if !(spacing.is_finite() && spacing > 0.0) || t.num_vertices() == 0 {
         return 0;
     }
-    let (lo, hi) = bounds(t);
-    let along = |extent: f64| (extent / spacing).round().max(1.0) + 1.0;
-    (along(hi.x - lo.x) * along(hi.y - lo.y)).min(u64::MAX as f64) as u64
+    let [nx, ny] = Lattice::new(t, spacing).n;
+    (nx as u64 + 1) * (ny as u64 + 1)
 }
 
 /// The bounding box of the triangulation's points.

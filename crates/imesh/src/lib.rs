@@ -994,6 +994,7 @@ impl Pipeline {
             (Vec::new(), Vec::new(), Vec::new(), lines)
         });
         self.stage(Stage::Quads);
+        let spacing = self.dt_spacing(&simplified.graph);
         let mut r = remesh(
             &simplified.graph,
             &curves,
@@ -1004,7 +1005,7 @@ impl Pipeline {
                         .unwrap_or(DensityOptions::default().min_angle_deg),
                     max_steiner: self.refinement_cap(),
                     max_size: o.max_size,
-                    spacing: self.dt_spacing(&simplified.graph),
+                    spacing,
                 },
                 pairing: match o.pairing {
                     PairingMethod::Greedy => Pairing::Greedy,
@@ -1029,7 +1030,7 @@ impl Pipeline {
         seconds.adaptation = r.seconds.adaptation;
         counts.simplified_edges = simplified.graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
-        counts.dt_spacing = self.dt_spacing(&simplified.graph).unwrap_or(0.0);
+        counts.dt_spacing = spacing.unwrap_or(0.0);
         counts.refinement_points = r.dt.refinement.inserted;
         counts.unpaired_triangles = r.elements.unpaired;
         counts.damped_curves = r.adaptation.damped_curves;
