@@ -43,6 +43,12 @@ struct Seconds {
     total: f64,
 }
 
+/// A fixture image, as the pipeline would load it.
+fn load(path: &Path) -> Result<image::DynamicImage, String> {
+    imesh_classify::load_image(path, imesh_classify::DEFAULT_MAX_PIXELS)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
 }
@@ -253,8 +259,7 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
     paths.sort();
     let (mut fixtures, mut uniform_fixtures) = (Vec::new(), Vec::new());
     for path in &paths {
-        let image = imesh_classify::load_image(path, imesh_classify::DEFAULT_MAX_PIXELS)
-            .map_err(|e| e.to_string())?;
+        let image = load(path)?;
         let name = path
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
@@ -270,11 +275,7 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
         &uniform_fixtures,
     );
 
-    let mri = imesh_classify::load_image(
-        &fixtures_dir().join("matplotlib-s1045_mri.png"),
-        imesh_classify::DEFAULT_MAX_PIXELS,
-    )
-    .map_err(|e| e.to_string())?;
+    let mri = load(&fixtures_dir().join("matplotlib-s1045_mri.png"))?;
     let mut density = Vec::new();
     for (name, options) in densities() {
         density.push(measure(name, &mri, &options)?);
@@ -284,11 +285,7 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
         &density,
     );
 
-    let camera = imesh_classify::load_image(
-        &fixtures_dir().join("skimage-camera.png"),
-        imesh_classify::DEFAULT_MAX_PIXELS,
-    )
-    .map_err(|e| e.to_string())?;
+    let camera = load(&fixtures_dir().join("skimage-camera.png"))?;
     let mut scaling = Vec::new();
     let mut side = 256;
     while side <= scaling_max {
