@@ -1,7 +1,5 @@
 //! The boundary graph: points, edges with the labels on their two sides, and pinned vertices.
 
-use std::collections::HashSet;
-
 use imesh_geom::Point;
 
 use crate::CurveError;
@@ -72,7 +70,6 @@ impl CurveGraph {
             return Err(CurveError::NonFinitePoint { index });
         }
         let n = points.len();
-        let mut seen = HashSet::with_capacity(edges.len());
         let mut count = vec![0u32; n + 1];
         for (index, e) in edges.iter().enumerate() {
             let [a, b] = e.ends;
@@ -81,9 +78,6 @@ impl CurveGraph {
                     index,
                     ends: e.ends,
                 });
-            }
-            if !seen.insert((a.min(b), a.max(b))) {
-                return Err(CurveError::DuplicateEdge { ends: e.ends });
             }
             count[a as usize + 1] += 1;
             count[b as usize + 1] += 1;
@@ -99,6 +93,32 @@ impl CurveGraph {
                 incident[fill[v as usize] as usize] = index as u32;
                 fill[v as usize] += 1;
             }
+        }
+        // Two edges joining the same vertices sit in the incident list of their lower end (in
+        // edge order): report the first edge that repeats an earlier one.
+        let other = |e: u32, v: u32| {
+            let [a, b] = edges[e as usize].ends;
+            if a == v {
+                b
+            } else {
+                a
+            }
+        };
+        let duplicate = (0..n as u32)
+            .filter_map(|v| {
+                let inc = &incident[first[v as usize] as usize..first[v as usize + 1] as usize];
+                inc.iter()
+                    .enumerate()
+                    .filter(|&(_, &e)| other(e, v) > v)
+                    .filter(|&(j, &e)| inc[..j].iter().any(|&f| other(f, v) == other(e, v)))
+                    .map(|(_, &e)| e)
+                    .next()
+            })
+            .min();
+        if let Some(e) = duplicate {
+            return Err(CurveError::DuplicateEdge {
+                ends: edges[e as usize].ends,
+            });
         }
         Ok(Self {
             pinned: vec![false; n],

@@ -53,7 +53,18 @@ impl Grid {
         self.nx * self.ny
     }
 
-    fn column(&self, x: f64) -> usize {
+    /// The number of columns.
+    pub(crate) fn columns(&self) -> usize {
+        self.nx
+    }
+
+    /// The abscissa where column `c` starts.
+    pub(crate) fn column_start(&self, c: usize) -> f64 {
+        self.origin.x + c as f64 * self.h
+    }
+
+    /// The column holding abscissa `x` (clamped to the grid).
+    pub(crate) fn column(&self, x: f64) -> usize {
         (((x - self.origin.x) / self.h).floor().max(0.0) as usize).min(self.nx - 1)
     }
 

@@ -87,12 +87,12 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
         return Err(CurveError::BadTolerance { tolerance });
     }
     // Cutting the polylines and indexing the graph are independent.
-    let (lines, mut state) = rayon::join(|| polylines(g), || State::new(g));
+    let (lines, state) = rayon::join(|| polylines(g), || State::new(g));
+    let (kept, state) = simplify_lines(&lines, state, tolerance);
     let mut edges = Vec::new();
     let mut chains = Vec::new();
     let mut polyline_of = Vec::new();
-    for (index, line) in lines.iter().enumerate() {
-        let kept = state.simplify_line(line, tolerance);
+    for (index, (line, kept)) in lines.iter().zip(&kept).enumerate() {
         for w in kept.windows(2) {
             let (i, j) = (w[0], w[1]);
             let chain = line.vertices[i..=j].to_vec();
@@ -120,8 +120,66 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
     })
 }
 
+/// Simplifies every polyline against `state`; returns the kept vertex indices of each.
+///
+/// A polyline's simplification reads and changes the graph only inside the polyline's bounding
+/// box: its chords and the regions between them and their chains lie there, and the tests reject
+/// anything whose box does not meet the chord's or the chain's. So the polylines strictly left of
+/// a vertical line and those strictly right of it are independent: each side is simplified
+/// against its own copy of the graph, side by side, the copies are merged, and the polylines
+/// that cross the line come last. The result is that of simplifying the left side, then the
+/// right side, then the rest, one after the other — the same on any number of threads.
+fn simplify_lines<'g>(
+    lines: &[Polyline],
+    mut state: State<'g>,
+    tolerance: f64,
+) -> (Vec<Vec<usize>>, State<'g>) {
+    let points = state.g.points();
+    let extent: Vec<[f64; 2]> = lines
+        .iter()
+        .map(|line| {
+            line.vertices
+                .iter()
+                .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], &v| {
+                    let x = points[v as usize].x;
+                    [lo.min(x), hi.max(x)]
+                })
+        })
+        .collect();
+    let split = state.balanced_split(lines, &extent);
+    let mut sides: [Vec<usize>; 3] = Default::default();
+    for (k, &[lo, hi]) in extent.iter().enumerate() {
+        let side = if hi < split {
+            0
+        } else if lo > split {
+            1
+        } else {
+            2
+        };
+        sides[side].push(k);
+    }
+    let mut kept = vec![Vec::new(); lines.len()];
+    let mut right = state.clone();
+    let run = |state: &mut State<'g>, ids: &[usize]| -> Vec<Vec<usize>> {
+        ids.iter()
+            .map(|&k| state.simplify_line(&lines[k], tolerance))
+            .collect()
+    };
+    let (left_kept, right_kept) =
+        rayon::join(|| run(&mut state, &sides[0]), || run(&mut right, &sides[1]));
+    state.absorb(&right);
+    let rest_kept = run(&mut state, &sides[2]);
+    for (ids, found) in sides.iter().zip([left_kept, right_kept, rest_kept]) {
+        for (&k, indices) in ids.iter().zip(found) {
+            kept[k] = indices;
+        }
+    }
+    (kept, state)
+}
+
 /// The current graph during simplification: every edge (original, or a chord that replaced a
 /// chain) with a liveness flag, the live vertices, and the grid over both.
+#[derive(Clone)]
 struct State<'g> {
     g: &'g CurveGraph,
     grid: Grid,
@@ -297,8 +355,49 @@ impl<'g> State<'g> {
         for &x in &line.vertices[i + 1..j] {
             self.vertex_alive[x as usize] = false;
         }
+        self.add_chord([line.vertices[i], line.vertices[j]]);
+    }
+
+    /// A vertical line `x = split` (a grid column boundary) with about as many polyline vertices
+    /// wholly on either side, given each polyline's x-extent.
+    fn balanced_split(&self, lines: &[Polyline], extent: &[[f64; 2]]) -> f64 {
+        let columns = self.grid.columns();
+        let mut weight = vec![0usize; columns + 1];
+        for (line, &[lo, hi]) in lines.iter().zip(extent) {
+            weight[self.grid.column(0.5 * (lo + hi))] += line.vertices.len();
+        }
+        let half = weight.iter().sum::<usize>() / 2;
+        let mut sum = 0;
+        let column = weight
+            .iter()
+            .position(|&w| {
+                sum += w;
+                sum >= half
+            })
+            .unwrap_or(0);
+        self.grid.column_start(column + 1)
+    }
+
+    /// Takes in what `other`, a copy of this state from before any simplification, did: the
+    /// edges and vertices it removed and the chords it added.
+    fn absorb(&mut self, other: &State<'_>) {
+        let m = self.g.edges().len();
+        for (alive, &there) in self.alive[..m].iter_mut().zip(&other.alive[..m]) {
+            *alive &= there;
+        }
+        for (alive, &there) in self.vertex_alive.iter_mut().zip(&other.vertex_alive) {
+            *alive &= there;
+        }
+        for &chord in &other.ends[m..] {
+            self.add_chord(chord);
+        }
+        self.refused += other.refused;
+        self.max_deviation = self.max_deviation.max(other.max_deviation);
+    }
+
+    /// Adds the chord `chord` to the current graph.
+    fn add_chord(&mut self, chord: [u32; 2]) {
         let id = self.ends.len() as u32;
-        let chord = [line.vertices[i], line.vertices[j]];
         self.ends.push(chord);
         self.alive.push(true);
         self.edge_seen.push(0);

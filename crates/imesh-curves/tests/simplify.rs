@@ -283,6 +283,31 @@ fn real_fixture_boundaries_simplify_with_their_topology() {
     }
 }
 
+/// The two sides of the image are simplified side by side: the result must not depend on how
+/// many threads do it.
+#[test]
+fn simplification_is_the_same_on_one_and_two_threads() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images/skimage-coins.png");
+    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+    let grey = imesh_classify::luminance(&image);
+    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 3));
+    let g = support::pixel_boundaries(&grid);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| simplify(&g, &SimplifyOptions::default()).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    assert!(one.refused > 0, "the fixture exercises the topology tests");
+    assert_eq!(one.chains, two.chains);
+    assert_eq!(one.polyline_of, two.polyline_of);
+    assert_eq!(one.refused, two.refused);
+    assert_eq!(one.graph.edges(), two.graph.edges());
+}
+
 #[test]
 fn bad_graphs_and_tolerances_are_refused_with_typed_errors() {
     let p = vec![Point::new(0.0, 0.0), Point::new(1.0, 0.0)];
