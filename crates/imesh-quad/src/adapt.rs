@@ -14,7 +14,8 @@ use crate::patch::ControlNet;
 pub struct AdaptReport {
     /// M edges on G' edges, given their fitted sub-curve.
     pub adapted_edges: usize,
-    /// Patches whose inner control points were relaxed because a quad inside had turned invalid.
+    /// Patches whose inner control points were relaxed because a quad inside had turned invalid
+    /// or poor.
     pub relaxed_patches: usize,
     /// G' edges pulled back towards their straight segment (their vertices are then between the
     /// chord and the curve) because relaxing the patches was not enough.
@@ -41,11 +42,18 @@ pub struct EdgeCurve {
     pub weight: f64,
 }
 
+/// A quad that adaptation leaves with a scaled Jacobian below both this and its straight value
+/// is repaired like an inverted one: the curve costs the element more than it is worth.
+pub const POOR_SCALED_JACOBIAN: f64 = 0.2;
+
 /// Moves the control points of every M edge on a G' edge onto the exact piece of that edge's
 /// fitted curve (`curves[k]` for G' edge `k`), re-evaluates Q, and repairs quads that turned
-/// invalid: first the patch's inner control points are relaxed (Coons), then, if needed, the
-/// offending G' edges' bulge is halved (all their pieces, Steiner corners included), down to the
-/// straight edge, whose templates are always valid.
+/// invalid, or poor (a scaled Jacobian below both [`POOR_SCALED_JACOBIAN`] and the quad's
+/// straight value): first the patch's inner control points are relaxed (Coons), then, if
+/// needed, the offending G' edges' bulge is halved (all their pieces, Steiner corners included),
+/// down to the straight edge, whose templates are always valid and never poor. A straight G'
+/// edge is within the simplification tolerance of its chain, so damping keeps the mesh within
+/// it too; the fitted curve is only closer.
 pub fn adapt(
     dt: &RegionTriangulation,
     g: &CurveGraph,
@@ -111,23 +119,35 @@ pub fn adapt(
         place(dt, m, net, ec);
     }
     report.adapted_edges = adapted.len();
-    // Only the elements with a moved corner or a curved side change.
-    let mut touched = vec![false; m.elements.len()];
-    for (index, element) in m.elements.iter().enumerate() {
-        let moved = element
-            .corners()
-            .iter()
-            .any(|&v| curve_of_vertex[v as usize] != NONE);
-        let curved = (0..m.side_count(index))
-            .any(|side| curve_of_edge[m.side_edge(index, side).0 as usize] != NONE);
-        if moved || curved {
-            touched[index] = true;
-            q.evaluate_element(m, net, index);
+    // Only the elements with a moved corner or a curved side change; their quads' straight
+    // scaled Jacobians are the bar adaptation must not push them under.
+    let touched: Vec<usize> = (0..m.elements.len())
+        .filter(|&index| {
+            let moved = m.elements[index]
+                .corners()
+                .iter()
+                .any(|&v| curve_of_vertex[v as usize] != NONE);
+            moved
+                || (0..m.side_count(index))
+                    .any(|side| curve_of_edge[m.side_edge(index, side).0 as usize] != NONE)
+        })
+        .collect();
+    let mut bar = vec![f64::NEG_INFINITY; q.quads.len()];
+    for &index in &touched {
+        for x in q.element_quads(index) {
+            bar[x] = POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9;
         }
     }
-    let invalid = |q: &QuadMesh, index: usize| q.element_quads(index).any(|x| !q.is_valid(x));
-    let mut bad: Vec<usize> = (0..m.elements.len())
-        .filter(|&i| touched[i] && invalid(q, i))
+    for &index in &touched {
+        q.evaluate_element(m, net, index);
+    }
+    let needs_repair = |q: &QuadMesh, index: usize| {
+        q.element_quads(index)
+            .any(|x| !q.is_valid(x) || q.scaled_jacobian(x) < bar[x])
+    };
+    let mut bad: Vec<usize> = touched
+        .into_iter()
+        .filter(|&i| needs_repair(q, i))
         .collect();
     // Per-round stamps: a G' edge is damped at most once a round, an element listed once.
     let mut curve_round = vec![0u32; g.edges().len()];
@@ -145,7 +165,11 @@ pub fn adapt(
             relaxed[index] = true;
         }
         let mut next = Vec::new();
-        let still: Vec<usize> = bad.iter().copied().filter(|&i| invalid(q, i)).collect();
+        let still: Vec<usize> = bad
+            .iter()
+            .copied()
+            .filter(|&i| needs_repair(q, i))
+            .collect();
         for index in still {
             let element = &m.elements[index];
             let sides = (0..m.side_count(index)).filter_map(|side| {

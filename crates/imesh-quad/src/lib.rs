@@ -46,7 +46,7 @@ mod pairing;
 mod patch;
 mod template;
 
-pub use adapt::{adapt, AdaptReport, EdgeCurve};
+pub use adapt::{adapt, AdaptReport, EdgeCurve, POOR_SCALED_JACOBIAN};
 pub use density::{uniform_points, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, NONE};
 pub use mesh::{Holder, QuadMesh};

@@ -9,6 +9,7 @@ use imesh_curves::{
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
+    POOR_SCALED_JACOBIAN,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -220,6 +221,28 @@ fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
         assert!(checked > 0);
         let _ = g;
     }
+}
+
+/// Adaptation never leaves a quad under both the poor bar and its straight scaled Jacobian: it
+/// damps the curves instead, and some curves must have needed it on these fixtures.
+#[test]
+fn adaptation_never_makes_a_quad_poor() {
+    let mut damped = 0;
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let r = run(&c, &QuadOptions::default());
+        let mut straight = r.mesh.clone();
+        straight.vertices.clone_from(&r.straight_vertices);
+        for x in 0..r.mesh.quads.len() {
+            let (after, before) = (r.mesh.scaled_jacobian(x), straight.scaled_jacobian(x));
+            assert!(
+                after >= POOR_SCALED_JACOBIAN.min(before) - 1e-9,
+                "{name}: quad {x} went from {before} to {after}"
+            );
+        }
+        damped += r.adaptation.damped_curves;
+    }
+    assert!(damped > 0);
 }
 
 #[test]
