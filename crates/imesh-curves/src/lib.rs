@@ -43,7 +43,7 @@ pub use bezier::{fit_cubic, fit_cubic_at, CubicBezier, CurveFit, FitOptions};
 pub use distance::{segment_distance, segment_distance_squared, segment_parameter};
 pub use graph::{CurveGraph, Face, GraphEdge};
 pub use polyline::{polylines, Polyline};
-pub use simplify::{simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE};
+pub use simplify::{simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN};
 
 /// Errors of the curve stage.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -28,6 +28,9 @@ use crate::CurveError;
 /// Default simplification tolerance in pixels.
 pub const DEFAULT_TOLERANCE: f64 = 2.0;
 
+/// The most pieces of a simplified polyline that its second pass joins into one chord.
+pub const MERGE_SPAN: usize = 8;
+
 /// Options of [`simplify`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimplifyOptions {
@@ -58,6 +61,9 @@ pub struct Simplification {
     pub polyline_of: Vec<u32>,
     /// Chords within the tolerance refused because they would have changed the topology.
     pub refused: usize,
+    /// Vertices that Douglas–Peucker kept and the second pass removed (see
+    /// [`MERGE_SPAN`]).
+    pub merged: usize,
     /// The largest distance from an original vertex to its simplified edge.
     pub max_deviation: f64,
 }
@@ -116,6 +122,7 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
         chains,
         polyline_of,
         refused: state.refused,
+        merged: state.merged,
         max_deviation: state.max_deviation,
     })
 }
@@ -197,6 +204,7 @@ struct State<'g> {
     vertex_in_chain: Vec<u32>,
     query: u32,
     refused: usize,
+    merged: usize,
     /// The largest distance from a removed vertex to its chord.
     max_deviation: f64,
 }
@@ -227,6 +235,7 @@ impl<'g> State<'g> {
             vertex_in_chain: vec![0; n],
             query: 0,
             refused: 0,
+            merged: 0,
             max_deviation: 0.0,
         }
     }
@@ -237,9 +246,14 @@ impl<'g> State<'g> {
         let mut keep = vec![false; v.len()];
         keep[0] = true;
         keep[v.len() - 1] = true;
+        // The current edge of the piece starting at each kept vertex.
+        let mut piece = vec![u32::MAX; v.len()];
         let mut stack = vec![(0, v.len() - 1)];
         while let Some((i, j)) = stack.pop() {
             if j <= i + 1 {
+                if j == i + 1 {
+                    piece[i] = line.edges[i];
+                }
                 continue;
             }
             let (a, b) = (self.g.point(v[i]), self.g.point(v[j]));
@@ -254,7 +268,7 @@ impl<'g> State<'g> {
             if deviation <= tolerance {
                 if straight(self.g.points(), &v[i..=j]) || self.chord_is_safe(line, i, j, deviation)
                 {
-                    self.replace(line, i, j);
+                    piece[i] = self.replace(line, i, j);
                     self.max_deviation = self.max_deviation.max(deviation);
                     continue;
                 }
@@ -264,19 +278,38 @@ impl<'g> State<'g> {
             stack.push((far, j));
             stack.push((i, far));
         }
-        (0..v.len()).filter(|&k| keep[k]).collect()
+        let kept: Vec<usize> = (0..v.len()).filter(|&k| keep[k]).collect();
+        if kept.len() <= 2 {
+            return kept;
+        }
+        self.merge_pieces(line, &kept, &piece, tolerance)
     }
 
     /// The two tests of the module documentation for the chord `v[i] v[j]` replacing the chain
     /// `v[i..=j]`, whose vertices are within `deviation` of the chord.
     fn chord_is_safe(&mut self, line: &Polyline, i: usize, j: usize, deviation: f64) -> bool {
+        let chain = &line.vertices[i..=j];
+        self.shortcut_is_safe(chain, &line.edges[i..j], chain, deviation)
+    }
+
+    /// The tests of [`State::chord_is_safe`] for a chord replacing the current curve `curve`
+    /// (vertex ids, first and last the chord's ends), whose current edges are `edges`; the
+    /// vertices in `own` are the curve's (some no longer live), and every vertex of `curve` is
+    /// within `deviation` of the chord.
+    fn shortcut_is_safe(
+        &mut self,
+        curve: &[u32],
+        edges: &[u32],
+        own: &[u32],
+        deviation: f64,
+    ) -> bool {
         self.query += 1;
         let q = self.query;
-        let chain = &line.vertices[i..=j];
-        for &e in &line.edges[i..j] {
+        let chain = curve;
+        for &e in edges {
             self.edge_in_chain[e as usize] = q;
         }
-        for &x in chain {
+        for &x in own {
             self.vertex_in_chain[x as usize] = q;
         }
         let chord = [chain[0], chain[chain.len() - 1]];
@@ -348,14 +381,72 @@ impl<'g> State<'g> {
     }
 
     /// Replaces the chain `v[i..=j]` by its chord in the current graph.
-    fn replace(&mut self, line: &Polyline, i: usize, j: usize) {
-        for &e in &line.edges[i..j] {
+    fn replace(&mut self, line: &Polyline, i: usize, j: usize) -> u32 {
+        self.replace_edges(&line.edges[i..j], &line.vertices[i + 1..j]);
+        self.add_chord([line.vertices[i], line.vertices[j]])
+    }
+
+    /// Removes `edges` and `vertices` from the current graph.
+    fn replace_edges(&mut self, edges: &[u32], vertices: &[u32]) {
+        for &e in edges {
             self.alive[e as usize] = false;
         }
-        for &x in &line.vertices[i + 1..j] {
+        for &x in vertices {
             self.vertex_alive[x as usize] = false;
         }
-        self.add_chord([line.vertices[i], line.vertices[j]]);
+    }
+
+    /// The second pass over a simplified polyline: Douglas–Peucker keeps every vertex that is
+    /// farthest from some chord, so a needle or a zig-zag (sliver triangles of alternating
+    /// labels along a straight boundary) keeps its tips even when the whole run lies within the
+    /// tolerance of one chord (a zig-zag's sub-chords all end at a tip: none is within the
+    /// tolerance until the whole run is). From each kept vertex, the longest run of up to
+    /// [`MERGE_SPAN`] following pieces whose original vertices are all within the tolerance of
+    /// one chord, and whose chord passes the topology tests against the current graph, becomes
+    /// that chord. Returns the kept indices left.
+    fn merge_pieces(
+        &mut self,
+        line: &Polyline,
+        kept: &[usize],
+        piece: &[u32],
+        tolerance: f64,
+    ) -> Vec<usize> {
+        let v = &line.vertices;
+        let points = self.g.points();
+        let mut out = vec![kept[0]];
+        let mut a = 0;
+        while a + 1 < kept.len() {
+            let mut best = (a + 1, 0.0);
+            for b in a + 2..kept.len().min(a + MERGE_SPAN + 1) {
+                let (i, j) = (kept[a], kept[b]);
+                let (p, q) = (points[v[i] as usize], points[v[j] as usize]);
+                let deviation = v[i + 1..j]
+                    .iter()
+                    .map(|&x| segment_distance_squared(p, q, points[x as usize]))
+                    .fold(0.0, f64::max)
+                    .sqrt();
+                if deviation > tolerance {
+                    continue;
+                }
+                let curve: Vec<u32> = kept[a..=b].iter().map(|&k| v[k]).collect();
+                let edges: Vec<u32> = kept[a..b].iter().map(|&k| piece[k]).collect();
+                if self.shortcut_is_safe(&curve, &edges, &v[i..=j], deviation) {
+                    best = (b, deviation);
+                }
+            }
+            let (b, deviation) = best;
+            if b > a + 1 {
+                let edges: Vec<u32> = kept[a..b].iter().map(|&k| piece[k]).collect();
+                let inner: Vec<u32> = kept[a + 1..b].iter().map(|&k| v[k]).collect();
+                self.replace_edges(&edges, &inner);
+                self.add_chord([v[kept[a]], v[kept[b]]]);
+                self.max_deviation = self.max_deviation.max(deviation);
+                self.merged += b - a - 1;
+            }
+            out.push(kept[b]);
+            a = b;
+        }
+        out
     }
 
     /// A vertical line `x = split` (a grid column boundary) with about as many polyline vertices
@@ -391,12 +482,13 @@ impl<'g> State<'g> {
         for &chord in &other.ends[m..] {
             self.add_chord(chord);
         }
+        self.merged += other.merged;
         self.refused += other.refused;
         self.max_deviation = self.max_deviation.max(other.max_deviation);
     }
 
     /// Adds the chord `chord` to the current graph.
-    fn add_chord(&mut self, chord: [u32; 2]) {
+    fn add_chord(&mut self, chord: [u32; 2]) -> u32 {
         let id = self.ends.len() as u32;
         self.ends.push(chord);
         self.alive.push(true);
@@ -406,6 +498,7 @@ impl<'g> State<'g> {
         let cells = &mut self.edge_cells;
         self.grid
             .cells_near_segment(a, b, 0.0, |c| cells.push(c, id));
+        id
     }
 }
 

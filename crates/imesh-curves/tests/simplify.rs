@@ -4,7 +4,7 @@ mod support;
 
 use imesh_curves::{
     fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph, FitOptions,
-    GraphEdge, Simplification, SimplifyOptions,
+    GraphEdge, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -306,6 +306,41 @@ fn simplification_is_the_same_on_one_and_two_threads() {
     assert_eq!(one.polyline_of, two.polyline_of);
     assert_eq!(one.refused, two.refused);
     assert_eq!(one.graph.edges(), two.graph.edges());
+}
+
+/// A straight boundary drawn as a zig-zag of needles (sliver triangles of alternating labels,
+/// as Imesh's c-edges can be): every sub-chord Douglas–Peucker tries ends at a needle tip and is
+/// 8 px off, so it keeps the tips; the second pass sees that the whole run is within 1 px of one
+/// chord and joins it.
+#[test]
+fn a_zig_zag_within_the_tolerance_loses_its_needles() {
+    let points: Vec<Point> = [
+        (149.5, 159.5),
+        (143.5, 161.5),
+        (142.5, 169.5),
+        (142.5, 161.5),
+        (141.5, 169.5),
+        (143.5, 179.5),
+        (160.0, 185.0),
+        (160.0, 150.0),
+    ]
+    .into_iter()
+    .map(|(x, y)| Point::new(x, y))
+    .collect();
+    // The zig-zag is one side of a closed region; its ends are pinned so that it is one
+    // polyline.
+    let edges = (0..7).map(|i| edge(i, (i + 1) % 7, [1, 0])).collect();
+    let mut g = CurveGraph::new(points, edges).unwrap();
+    g.pin(0).unwrap();
+    g.pin(5).unwrap();
+    let s = simplify(&g, &SimplifyOptions::default()).unwrap();
+    check_simplification(&g, &s, DEFAULT_TOLERANCE);
+    let kept: Vec<u32> = s.graph.edges().iter().flat_map(|e| e.ends).collect();
+    assert!(
+        !kept.contains(&2) && !kept.contains(&3),
+        "needle tips kept: {kept:?}"
+    );
+    assert!(s.merged >= 2);
 }
 
 #[test]

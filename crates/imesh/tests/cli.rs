@@ -250,14 +250,20 @@ fn the_triangle_mesh_and_quad_options() {
                 "mean"
             )
     );
+    // Shape-and-size divides by the mean quad area, summed again after the optimiser moved the
+    // vertices: an untouched worst quad may differ in the last bits.
+    let (worst_after, worst_before) = (
+        stat(&matching, "quality", "shape_and_size", "min"),
+        stat(
+            &matching,
+            "quality_before_optimisation",
+            "shape_and_size",
+            "min",
+        ),
+    );
     assert!(
-        stat(&matching, "quality", "shape_and_size", "min")
-            >= stat(
-                &matching,
-                "quality_before_optimisation",
-                "shape_and_size",
-                "min"
-            )
+        worst_after >= worst_before * (1.0 - 1e-12),
+        "worst shape-and-size {worst_before} → {worst_after}"
     );
     let none = run(&["--optimizer", "none"], "none.json");
     for metric in ["shape_and_size", "shape", "scaled_jacobian"] {
