@@ -237,6 +237,65 @@ pub(crate) fn edge_cells(g: &CurveGraph, grid: &Grid) -> CellLists {
     CellLists::new(grid.len(), &pairs)
 }
 
+/// Segments bucketed by the cells of a uniform grid that come within a distance `reach` of
+/// them: the candidates near a point are every segment within `reach` of it, and a few farther
+/// ones, read from one cell. For "is anything closer than `reach`?" over many points.
+///
+/// ```
+/// use imesh_curves::{segment_distance, SegmentIndex};
+/// use imesh_geom::Point;
+/// let segments = [
+///     [Point::new(0.0, 0.0), Point::new(10.0, 0.0)],
+///     [Point::new(0.0, 5.0), Point::new(0.0, 9.0)],
+/// ];
+/// let index = SegmentIndex::new(&segments, 1.0);
+/// let p = Point::new(5.0, 0.5);
+/// let close: Vec<u32> = index
+///     .near(p)
+///     .filter(|&k| {
+///         let [a, b] = segments[k as usize];
+///         segment_distance(a, b, p) < 1.0
+///     })
+///     .collect();
+/// assert_eq!(close, [0]);
+/// ```
+#[derive(Clone, Debug)]
+pub struct SegmentIndex {
+    grid: Grid,
+    cells: CellLists,
+}
+
+impl SegmentIndex {
+    /// Indexes `segments` (by their position in the slice) for queries within `reach` of them
+    /// (a negative or non-finite reach counts as 0). The grid has about one cell per segment.
+    pub fn new(segments: &[[Point; 2]], reach: f64) -> Self {
+        let reach = if reach.is_finite() {
+            reach.max(0.0)
+        } else {
+            0.0
+        };
+        let corners = segments.iter().flatten().flat_map(|p| {
+            [
+                Point::new(p.x - reach, p.y - reach),
+                Point::new(p.x + reach, p.y + reach),
+            ]
+        });
+        let grid = Grid::new(corners, segments.len());
+        let mut pairs = Vec::with_capacity(2 * segments.len());
+        for (k, &[a, b]) in segments.iter().enumerate() {
+            // The segment grown by `reach` in x and y holds every point within `reach` of it.
+            grid.cells_near_segment(a, b, reach, |c| pairs.push((c as u32, k as u32)));
+        }
+        let cells = CellLists::new(grid.len(), &pairs);
+        Self { grid, cells }
+    }
+
+    /// The indices of the segments that may lie within `reach` of `p`: at least all that do.
+    pub fn near(&self, p: Point) -> impl Iterator<Item = u32> + '_ {
+        self.cells.iter(self.grid.cell(p))
+    }
+}
+
 /// A grid with about one cell per four edges (cells a few edge lengths wide).
 pub(crate) fn grid_for(g: &CurveGraph) -> Grid {
     let used = g.edges().iter().flat_map(|e| e.ends).map(|v| g.point(v));

@@ -42,6 +42,7 @@ use rayon::prelude::*;
 pub use bezier::{fit_cubic, fit_cubic_at, CubicBezier, CurveFit, FitOptions};
 pub use distance::{segment_distance, segment_distance_squared, segment_parameter};
 pub use graph::{CurveGraph, Face, GraphEdge};
+pub use grid::SegmentIndex;
 pub use polyline::{polylines, Polyline};
 pub use simplify::{simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN};
 

@@ -4,7 +4,7 @@ mod support;
 
 use imesh_curves::{
     fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph, FitOptions,
-    GraphEdge, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
+    GraphEdge, SegmentIndex, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -111,6 +111,31 @@ fn label_image() -> impl Strategy<Value = (u32, u32, Vec<u32>)> {
 }
 
 const TOLERANCES: [f64; 4] = [0.5, 2.0, 5.0, 15.0];
+
+proptest! {
+    /// The segment index never misses a segment within its reach of the query point.
+    #[test]
+    fn the_segment_index_finds_every_segment_within_reach(
+        ends in prop::collection::vec((-50.0..50.0f64, -50.0..50.0f64, -50.0..50.0f64, -50.0..50.0f64), 1..40),
+        queries in prop::collection::vec((-60.0..60.0f64, -60.0..60.0f64), 1..40),
+        reach in 0.0..8.0f64,
+    ) {
+        let segments: Vec<[Point; 2]> = ends
+            .iter()
+            .map(|&(ax, ay, bx, by)| [Point::new(ax, ay), Point::new(bx, by)])
+            .collect();
+        let index = SegmentIndex::new(&segments, reach);
+        for &(x, y) in &queries {
+            let p = Point::new(x, y);
+            let near: Vec<u32> = index.near(p).collect();
+            for (k, &[a, b]) in segments.iter().enumerate() {
+                if segment_distance(a, b, p) <= reach {
+                    prop_assert!(near.contains(&(k as u32)), "segment {} missed at {:?}", k, p);
+                }
+            }
+        }
+    }
+}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]

@@ -8,7 +8,7 @@
 //! templates cut into squares: the inside becomes a grid of equal squares, and only a band along
 //! the boundaries is left to refinement.
 
-use imesh_curves::segment_distance;
+use imesh_curves::{segment_distance, SegmentIndex};
 use imesh_geom::{GeomError, Location, Point, Triangulation, EXTERIOR};
 
 /// How far a lattice point stays from every boundary piece, in spacings: nearer, it would make a
@@ -53,7 +53,7 @@ pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, Geom
     let reach = CLEARANCE * spacing;
 
     // 1. The border.
-    let grid = EdgeGrid::new(t, &lattice, reach);
+    let grid = EdgeGrid::new(t, reach);
     let mut border = Vec::new();
     for (i, j) in lattice.border() {
         let p = lattice.point(i, j);
@@ -86,7 +86,7 @@ pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, Geom
     t.split_long_segments(spacing)?;
 
     // 3. The inside.
-    let grid = EdgeGrid::new(t, &lattice, reach);
+    let grid = EdgeGrid::new(t, reach);
     let labelled = t.triangles().any(|f| t.label(f) != EXTERIOR);
     for j in 1..lattice.n[1] {
         for i in 1..lattice.n[0] {
@@ -175,73 +175,29 @@ impl Lattice {
         let columns = (1..ny).flat_map(move |j| [(0, j), (nx, j)]);
         rows.chain(columns)
     }
-
-    /// The cell of `p`, clamped to the lattice.
-    fn cell(&self, p: Point) -> (usize, usize) {
-        let along = |v: f64, lo: f64, step: f64, n: usize| {
-            (((v - lo) / step).floor().max(0.0) as usize).min(n - 1)
-        };
-        (
-            along(p.x, self.lo.x, self.step[0], self.n[0]),
-            along(p.y, self.lo.y, self.step[1], self.n[1]),
-        )
-    }
 }
 
-/// The triangulation's segment pieces, bucketed by the lattice cells within `reach` of them.
-struct EdgeGrid<'a> {
-    lattice: &'a Lattice,
+/// The triangulation's segment pieces, indexed for "is any within `reach`?".
+struct EdgeGrid {
     edges: Vec<[Point; 2]>,
-    /// For each cell (row-major), the pieces that come within `reach` of it.
-    cells: Vec<Vec<u32>>,
+    index: SegmentIndex,
 }
 
-impl<'a> EdgeGrid<'a> {
-    fn new(t: &Triangulation, lattice: &'a Lattice, reach: f64) -> Self {
+impl EdgeGrid {
+    fn new(t: &Triangulation, reach: f64) -> Self {
         let edges: Vec<[Point; 2]> = t
             .constrained_edges()
             .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
             .collect();
-        let [nx, ny] = lattice.n;
-        let mut cells = vec![Vec::new(); nx * ny];
-        let spacing = lattice.step[0].max(lattice.step[1]);
-        for (k, &[a, b]) in edges.iter().enumerate() {
-            // A long piece is registered a spacing-long stretch at a time, so that it lands only
-            // in the cells along it.
-            let stretches = (a.distance_squared(b).sqrt() / spacing).ceil().max(1.0) as usize;
-            for s in 0..stretches {
-                let (f0, f1) = (
-                    s as f64 / stretches as f64,
-                    (s + 1) as f64 / stretches as f64,
-                );
-                let (p, q) = (a + (b - a) * f0, a + (b - a) * f1);
-                let (i0, j0) = lattice.cell(Point::new(p.x.min(q.x) - reach, p.y.min(q.y) - reach));
-                let (i1, j1) = lattice.cell(Point::new(p.x.max(q.x) + reach, p.y.max(q.y) + reach));
-                for j in j0..=j1 {
-                    for i in i0..=i1 {
-                        let c = &mut cells[j * nx + i];
-                        if c.last() != Some(&(k as u32)) {
-                            c.push(k as u32);
-                        }
-                    }
-                }
-            }
-        }
-        Self {
-            lattice,
-            edges,
-            cells,
-        }
+        let index = SegmentIndex::new(&edges, reach);
+        Self { edges, index }
     }
 
     /// True when every piece near `p` is at least `reach` away by `distance`.
     fn clear(&self, p: Point, reach: f64, distance: impl Fn([Point; 2]) -> f64) -> bool {
-        // Pieces were bucketed by the same cell function over their reach, so the cell of `p`
-        // holds every piece within reach of it.
-        let (i, j) = self.lattice.cell(p);
-        self.cells[j * self.lattice.n[0] + i]
-            .iter()
-            .all(|&k| distance(self.edges[k as usize]) >= reach)
+        self.index
+            .near(p)
+            .all(|k| distance(self.edges[k as usize]) >= reach)
     }
 }
 
