@@ -35,9 +35,9 @@ impl Default for SampleOptions {
 /// The result of [`sample`].
 #[derive(Clone, Debug)]
 pub struct Sampling {
-    /// The Delaunay triangulation of the four domain corners and the inserted pixel centres.
+    /// The Delaunay triangulation of the four domain corners and the inserted points.
     pub triangulation: Triangulation,
-    /// Pixel centres inserted.
+    /// Points inserted: the label changes along the border (see [`sample`]), then pixel centres.
     pub inserted: usize,
     /// Rounds of parallel evaluation.
     pub rounds: usize,
@@ -127,9 +127,39 @@ pub fn median_error(grid: &LabelGrid, p: [Point; 3]) -> MedianError {
     best
 }
 
-/// Samples the label grid: starting from the two triangles of the domain's corners, inserts the
-/// worst pixel centre of every triangle whose median error exceeds `te`, round after round, until
-/// none does.
+/// The points of the domain border between two neighbouring border pixels of different labels.
+fn border_changes(grid: &LabelGrid) -> Vec<Point> {
+    let (w, h) = (grid.width(), grid.height());
+    let (fw, fh) = (f64::from(w), f64::from(h));
+    let mut points = Vec::new();
+    for c in 1..w {
+        if grid.label(c - 1, 0) != grid.label(c, 0) {
+            points.push(Point::new(f64::from(c), 0.0));
+        }
+        if grid.label(c - 1, h - 1) != grid.label(c, h - 1) {
+            points.push(Point::new(f64::from(c), fh));
+        }
+    }
+    for r in 1..h {
+        if grid.label(0, r - 1) != grid.label(0, r) {
+            points.push(Point::new(0.0, f64::from(r)));
+        }
+        if grid.label(w - 1, r - 1) != grid.label(w - 1, r) {
+            points.push(Point::new(fw, f64::from(r)));
+        }
+    }
+    points
+}
+
+/// Samples the label grid: starting from the triangulation of the domain's corners and the
+/// label changes along its border, inserts the worst pixel centre of every triangle whose median
+/// error exceeds `te`, round after round, until none does.
+///
+/// The border points sit on the border between two border pixels of different labels. Without
+/// them the border has no vertex but the corners: the triangles along it reach from a corner to
+/// pixel centres half a pixel inside, and take one label over a whole side, so that every region
+/// touching the border is cut off from it by a strip half a pixel wide (and its boundary ends in a
+/// needle at the corner).
 ///
 /// Each round evaluates the triangles the previous round created, in parallel, then inserts their
 /// worst pixels one after another in a fixed order (largest error first, then pixel index),
@@ -165,10 +195,13 @@ pub fn sample(grid: &LabelGrid, options: &SampleOptions) -> Result<Sampling, Seg
         Point::new(fw, fh),
         Point::new(0.0, fh),
     ];
-    let (mut tri, _) = Triangulation::from_points(&corners)?;
+    let border = border_changes(grid);
+    let mut start = corners.to_vec();
+    start.extend_from_slice(&border);
+    let (mut tri, _) = Triangulation::from_points(&start)?;
     let mut used = vec![false; w as usize * h as usize];
     let mut pending: Vec<TriangleId> = tri.triangles().collect();
-    let (mut inserted, mut rounds, mut capped) = (0usize, 0usize, false);
+    let (mut inserted, mut rounds, mut capped) = (border.len(), 0usize, false);
     while !pending.is_empty() {
         rounds += 1;
         let evaluated: Vec<(TriangleId, [VertexId; 3], MedianError)> = pending

@@ -131,6 +131,57 @@ fn every_shape_gives_a_valid_labelled_partition() {
     }
 }
 
+/// Every region that touches the border reaches it: each border c-edge carries the label of
+/// every border pixel along it (no strip of another label half a pixel wide in between).
+#[test]
+fn regions_reach_the_border() {
+    let halves = grid(16, 12, 2, |c, _| u32::from(c >= 9));
+    for (name, g) in shapes().into_iter().chain([("halves", halves)]) {
+        let m = SegmentedMesh::from_grid(&g, &SampleOptions::default()).unwrap();
+        let (w, h) = (f64::from(g.width()), f64::from(g.height()));
+        let mut along = 0.0;
+        for e in m.c_edges.iter().filter(|e| e.labels.contains(&OUTSIDE)) {
+            let region = if e.labels[0] == OUTSIDE {
+                e.labels[1]
+            } else {
+                e.labels[0]
+            };
+            let [a, b] = e.vertices.map(|v| m.triangulation.point(v));
+            // The border pixels under the edge: their centres' projections lie between its ends.
+            let pixels: Vec<(u32, u32)> = if a.y == b.y {
+                let r = if a.y == 0.0 { 0 } else { g.height() - 1 };
+                let (x0, x1) = (a.x.min(b.x), a.x.max(b.x));
+                (0..g.width())
+                    .filter(|&c| (x0..=x1).contains(&(f64::from(c) + 0.5)))
+                    .map(|c| (c, r))
+                    .collect()
+            } else {
+                assert_eq!(a.x, b.x, "{name}: a border c-edge off the border");
+                let c = if a.x == 0.0 { 0 } else { g.width() - 1 };
+                let (y0, y1) = (a.y.min(b.y), a.y.max(b.y));
+                (0..g.height())
+                    .filter(|&r| (y0..=y1).contains(&(f64::from(r) + 0.5)))
+                    .map(|r| (c, r))
+                    .collect()
+            };
+            for (c, r) in pixels {
+                assert_eq!(
+                    g.label(c, r),
+                    region,
+                    "{name}: border pixel ({c}, {r}) is {} but its border c-edge {a:?}–{b:?} is {region}",
+                    g.label(c, r)
+                );
+            }
+            along += a.distance_squared(b).sqrt();
+        }
+        assert_eq!(
+            along,
+            2.0 * (w + h),
+            "{name}: the border c-edges cover the border"
+        );
+    }
+}
+
 #[test]
 fn a_single_label_image_needs_no_vertex() {
     for g in [
