@@ -71,12 +71,12 @@ impl FromStr for PairingMethod {
 #[serde(into = "String", try_from = "String")]
 pub enum ElementSize {
     /// Uniform, at the spacing the simplified boundaries suggest: the upper quartile of their
-    /// edge lengths, at least [`MIN_AUTO_SPACING`] pixels, as the spacing of DT'.
+    /// edge lengths, at least [`MIN_AUTO_SPACING`] pixels, as the spacing of DT' (default).
     Auto,
     /// Uniform quads of about this side, in pixels (DT' spacing: 2 × level × this).
     Pixels(f64),
-    /// DT' graded from the boundaries' own pieces inwards, by refinement alone (the paper's;
-    /// default): fewer elements, lower shape-and-size.
+    /// DT' graded from the boundaries' own pieces inwards, by refinement alone (the paper's):
+    /// fewer elements, lower shape-and-size.
     Graded,
 }
 
@@ -265,7 +265,7 @@ impl Default for MeshOptions {
             min_angle: None,
             max_steiner: None,
             max_size: None,
-            size: ElementSize::Graded,
+            size: ElementSize::Auto,
             min_region: 0,
             majority: 0,
             tolerance: imesh_curves::DEFAULT_TOLERANCE,

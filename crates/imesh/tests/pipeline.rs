@@ -120,7 +120,11 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         .find(|p| p.ends_with("matplotlib-s1045_mri.png"))
         .expect("the MRI fixture");
     let run = |options: MeshOptions| Pipeline::new(options).run_path(&path).unwrap().report;
-    let graded = run(MeshOptions::default());
+    let graded = run(MeshOptions {
+        size: ElementSize::Graded,
+        ..Default::default()
+    });
+    let auto = run(MeshOptions::default());
     let uniform = run(MeshOptions {
         size: ElementSize::Pixels(3.0),
         ..Default::default()
@@ -136,17 +140,20 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         majority: 2,
         ..Default::default()
     });
-    for r in [&graded, &uniform, &cleaned, &smoothed] {
+    for r in [&graded, &auto, &uniform, &cleaned, &smoothed] {
         assert!(r.validation.valid && r.quality.scaled_jacobian().min > 0.0);
     }
     let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
     eprintln!(
-        "mean shape-and-size: graded {:.3}, size 3 {:.3}, + min region 50 {:.3}, + majority 2 {:.3}",
+        "mean shape-and-size: graded {:.3}, auto (default) {:.3}, size 3 {:.3}, + min region 50 {:.3}, + majority 2 {:.3}",
         mean(&graded),
+        mean(&auto),
         mean(&uniform),
         mean(&cleaned),
         mean(&smoothed)
     );
+    assert!(mean(&auto) > mean(&graded) + 0.1);
+    assert!(auto.counts.dt_spacing >= imesh::MIN_AUTO_SPACING);
     assert!(mean(&uniform) > mean(&graded) + 0.2);
     assert!(mean(&cleaned) > mean(&uniform) + 0.1);
     assert_eq!(graded.counts.dt_spacing, 0.0);
