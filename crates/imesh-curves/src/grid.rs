@@ -228,11 +228,15 @@ impl CellLists {
 
 /// Registers each edge of `g` in the cells it meets.
 pub(crate) fn edge_cells(g: &CurveGraph, grid: &Grid) -> CellLists {
-    let mut pairs = Vec::with_capacity(2 * g.edges().len());
-    for (i, e) in g.edges().iter().enumerate() {
-        grid.cells_near_segment(g.point(e.ends[0]), g.point(e.ends[1]), 0.0, |c| {
-            pairs.push((c as u32, i as u32));
-        });
+    let segments = g.edges().iter().map(|e| e.ends.map(|v| g.point(v)));
+    bucket(grid, segments, 0.0)
+}
+
+/// Registers each segment (by its position in `segments`) in the cells it meets grown by `pad`.
+fn bucket(grid: &Grid, segments: impl ExactSizeIterator<Item = [Point; 2]>, pad: f64) -> CellLists {
+    let mut pairs = Vec::with_capacity(2 * segments.len());
+    for (k, [a, b]) in segments.enumerate() {
+        grid.cells_near_segment(a, b, pad, |c| pairs.push((c as u32, k as u32)));
     }
     CellLists::new(grid.len(), &pairs)
 }
@@ -281,12 +285,8 @@ impl SegmentIndex {
             ]
         });
         let grid = Grid::new(corners, segments.len());
-        let mut pairs = Vec::with_capacity(2 * segments.len());
-        for (k, &[a, b]) in segments.iter().enumerate() {
-            // The segment grown by `reach` in x and y holds every point within `reach` of it.
-            grid.cells_near_segment(a, b, reach, |c| pairs.push((c as u32, k as u32)));
-        }
-        let cells = CellLists::new(grid.len(), &pairs);
+        // A segment grown by `reach` in x and y holds every point within `reach` of it.
+        let cells = bucket(&grid, segments.iter().copied(), reach);
         Self { grid, cells }
     }
 

@@ -292,20 +292,19 @@ impl<'g> State<'g> {
         self.shortcut_is_safe(chain, &line.edges[i..j], chain, deviation)
     }
 
-    /// The tests of [`State::chord_is_safe`] for a chord replacing the current curve `curve`
+    /// The tests of [`State::chord_is_safe`] for a chord replacing the current curve `chain`
     /// (vertex ids, first and last the chord's ends), whose current edges are `edges`; the
-    /// vertices in `own` are the curve's (some no longer live), and every vertex of `curve` is
+    /// vertices in `own` are the curve's (some no longer live), and every vertex of `chain` is
     /// within `deviation` of the chord.
     fn shortcut_is_safe(
         &mut self,
-        curve: &[u32],
+        chain: &[u32],
         edges: &[u32],
         own: &[u32],
         deviation: f64,
     ) -> bool {
         self.query += 1;
         let q = self.query;
-        let chain = curve;
         for &e in edges {
             self.edge_in_chain[e as usize] = q;
         }

@@ -289,13 +289,18 @@ fn a_loop_hanging_off_a_junction_is_cut_too() {
     assert!(lines.iter().all(|l| l.ends()[0] != l.ends()[1]));
 }
 
-#[test]
-fn real_fixture_boundaries_simplify_with_their_topology() {
+/// The coins fixture thresholded into `classes` labels by multi-Otsu.
+fn coins(classes: usize) -> imesh_classify::LabelGrid {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../fixtures/images/skimage-coins.png");
     let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
     let grey = imesh_classify::luminance(&image);
-    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 2));
+    imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, classes))
+}
+
+#[test]
+fn real_fixture_boundaries_simplify_with_their_topology() {
+    let grid = coins(2);
     for g in [
         support::pixel_boundaries(&grid),
         support::imesh_boundaries(&grid),
@@ -312,11 +317,7 @@ fn real_fixture_boundaries_simplify_with_their_topology() {
 /// many threads do it.
 #[test]
 fn simplification_is_the_same_on_one_and_two_threads() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images/skimage-coins.png");
-    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
-    let grey = imesh_classify::luminance(&image);
-    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 3));
+    let grid = coins(3);
     let g = support::pixel_boundaries(&grid);
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -422,11 +423,7 @@ fn crossing_edges_are_found() {
 
 #[test]
 fn fitted_curves_join_the_simplified_vertices_within_the_tolerance() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images/skimage-coins.png");
-    let image = imesh_classify::load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
-    let grey = imesh_classify::luminance(&image);
-    let grid = imesh_classify::threshold(&grey, &imesh_classify::multi_otsu_levels(&grey, 3));
+    let grid = coins(3);
     let g = support::imesh_boundaries(&grid);
     for tolerance in [0.5, 2.0, 5.0] {
         let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();

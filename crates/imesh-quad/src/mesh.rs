@@ -192,22 +192,9 @@ impl QuadMesh {
         (0..4).all(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) > 0.0)
     }
 
-    /// The scaled Jacobian of quad `q`: the least sine of its corner angles, signed (Verdict's
-    /// definition for a counter-clockwise quad; negative at a reflex corner). 0 for a quad with
-    /// a zero-length side.
+    /// The scaled Jacobian of quad `q` (see [`scaled_jacobian`]).
     pub fn scaled_jacobian(&self, q: usize) -> f64 {
-        let p = self.quads[q].map(|v| self.vertices[v as usize]);
-        (0..4)
-            .map(|i| {
-                let (a, b) = (p[i] - p[(i + 3) % 4], p[(i + 1) % 4] - p[i]);
-                let lengths = (a.x * a.x + a.y * a.y).sqrt() * (b.x * b.x + b.y * b.y).sqrt();
-                if lengths > 0.0 {
-                    (a.x * b.y - a.y * b.x) / lengths
-                } else {
-                    0.0
-                }
-            })
-            .fold(f64::INFINITY, f64::min)
+        scaled_jacobian(&self.quads[q].map(|v| self.vertices[v as usize]))
     }
 
     /// The total (signed) area of the quads.
@@ -221,4 +208,21 @@ impl QuadMesh {
             })
             .sum()
     }
+}
+
+/// The scaled Jacobian of the quad `p`: the least sine of its corner angles, signed (Verdict's
+/// definition for a counter-clockwise quad; negative at a reflex corner). 0 for a quad with a
+/// zero-length side.
+pub(crate) fn scaled_jacobian(p: &[Point; 4]) -> f64 {
+    (0..4)
+        .map(|i| {
+            let (a, b) = (p[(i + 1) % 4] - p[i], p[(i + 3) % 4] - p[i]);
+            let lengths = ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y)).sqrt();
+            if lengths > 0.0 {
+                (a.x * b.y - a.y * b.x) / lengths
+            } else {
+                0.0
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
 }

@@ -4,6 +4,7 @@ use imesh_geom::predicates::orient2d;
 use imesh_geom::{HalfEdgeId, Point, TriangleId, Triangulation};
 
 use crate::dt::NONE;
+use crate::mesh::scaled_jacobian;
 
 /// How triangles are paired.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -193,17 +194,6 @@ fn strictly_convex(q: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(q[(i + 3) % 4], q[i], q[(i + 1) % 4]) > 0.0)
 }
 
-/// The quad's worst corner: the smallest sine of its four angles (its scaled Jacobian).
-fn worst_corner(q: &[Point; 4]) -> f64 {
-    (0..4)
-        .map(|i| {
-            let (a, b) = (q[(i + 1) % 4] - q[i], q[(i + 3) % 4] - q[i]);
-            let cross = a.x * b.y - a.y * b.x;
-            cross / ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y)).sqrt()
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 fn pair_up(partner: &mut [u32], f: TriangleId, n: TriangleId) {
     partner[f.index()] = n.index() as u32;
     partner[n.index()] = f.index() as u32;
@@ -238,7 +228,7 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
             continue;
         }
         let Some(q) = quad_across(t, h) else { continue };
-        if !strictly_convex(&q) || worst_corner(&q) < MIN_GREEDY_CORNER {
+        if !strictly_convex(&q) || scaled_jacobian(&q) < MIN_GREEDY_CORNER {
             continue;
         }
         pair_up(&mut partner, f, n);
@@ -263,7 +253,7 @@ fn matching(t: &Triangulation) -> Vec<u32> {
     let good = |h: HalfEdgeId| {
         quad_across(t, h)
             .filter(strictly_convex)
-            .map(|q| worst_corner(&q))
+            .map(|q| scaled_jacobian(&q))
             .filter(|&w| w >= MIN_MATCHING_CORNER)
     };
     let mut candidates: Vec<(f64, HalfEdgeId)> =
