@@ -11,6 +11,10 @@ use crate::graph::CurveGraph;
 pub(crate) struct Grid {
     origin: Point,
     h: f64,
+    /// `1 / h`: cell lookups multiply (a division costs several times as long, and lookups
+    /// are most of a query's arithmetic). Rounding makes no difference that matters: a lookup is
+    /// monotone in its coordinate either way.
+    inverse_h: f64,
     nx: usize,
     ny: usize,
 }
@@ -43,6 +47,7 @@ impl Grid {
         Self {
             origin: lo,
             h,
+            inverse_h: 1.0 / h,
             nx,
             ny,
         }
@@ -65,11 +70,11 @@ impl Grid {
 
     /// The column holding abscissa `x` (clamped to the grid).
     pub(crate) fn column(&self, x: f64) -> usize {
-        (((x - self.origin.x) / self.h).floor().max(0.0) as usize).min(self.nx - 1)
+        index((x - self.origin.x) * self.inverse_h, self.nx)
     }
 
     fn row(&self, y: f64) -> usize {
-        (((y - self.origin.y) / self.h).floor().max(0.0) as usize).min(self.ny - 1)
+        index((y - self.origin.y) * self.inverse_h, self.ny)
     }
 
     /// The cell holding `p` (clamped to the grid).
@@ -122,6 +127,17 @@ impl Grid {
     }
 }
 
+/// `⌊t⌋` clamped to `0..n`. A cast truncates towards zero, which is the floor for the
+/// non-negative values it sees here, and it needs no call to `floor` on baseline x86-64;
+/// NaN casts to 0.
+fn index(t: f64, n: usize) -> usize {
+    if t > 0.0 {
+        (t as usize).min(n - 1)
+    } else {
+        0
+    }
+}
+
 /// True when the closed segments `ab` and `cd` meet anywhere except at one shared end vertex
 /// (vertex identity by index: `ends` are `[a, b]` and `[c, d]`). Sharing an end and running on
 /// along the same line (overlap) is a conflict; so is any touch between segments with no common
@@ -167,23 +183,17 @@ pub(crate) fn within(a: Point, b: Point, q: Point) -> bool {
     q.x >= a.x.min(b.x) && q.x <= a.x.max(b.x) && q.y >= a.y.min(b.y) && q.y <= a.y.max(b.y)
 }
 
-/// Items per cell: those known at the start stored contiguously per cell (compressed rows, so a
-/// query reads one slice), and those added later as singly linked lists in flat arrays (appending
-/// never allocates per cell).
+/// Items per cell, known at the start: stored contiguously per cell (compressed rows), so that a
+/// query reads one slice.
 #[derive(Clone, Debug)]
-pub(crate) struct CellLists {
+pub(crate) struct CellLists<T = u32> {
     first: Vec<u32>,
-    items: Vec<u32>,
-    head: Vec<u32>,
-    next: Vec<u32>,
-    added: Vec<u32>,
+    items: Vec<T>,
 }
 
-const END: u32 = u32::MAX;
-
-impl CellLists {
+impl<T: Copy + Default> CellLists<T> {
     /// The lists of `cells` cells holding `(cell, item)` pairs.
-    pub(crate) fn new(cells: usize, pairs: &[(u32, u32)]) -> Self {
+    pub(crate) fn new(cells: usize, pairs: &[(u32, T)]) -> Self {
         // A counting sort by cell.
         let mut first = vec![0u32; cells + 1];
         for &(c, _) in pairs {
@@ -193,36 +203,58 @@ impl CellLists {
             first[c + 1] += first[c];
         }
         let mut fill = first.clone();
-        let mut items = vec![0u32; pairs.len()];
+        let mut items = vec![T::default(); pairs.len()];
         for &(c, item) in pairs {
             items[fill[c as usize] as usize] = item;
             fill[c as usize] += 1;
         }
+        Self { first, items }
+    }
+
+    /// The items of `cell`.
+    pub(crate) fn get(&self, cell: usize) -> &[T] {
+        &self.items[self.first[cell] as usize..self.first[cell + 1] as usize]
+    }
+}
+
+/// Items per cell added one by one: singly linked lists in flat arrays, so that appending never
+/// allocates per cell.
+#[derive(Clone, Debug)]
+pub(crate) struct CellChains {
+    head: Vec<u32>,
+    next: Vec<u32>,
+    added: Vec<u32>,
+}
+
+const END: u32 = u32::MAX;
+
+impl CellChains {
+    /// Empty lists for `cells` cells.
+    pub(crate) fn new(cells: usize) -> Self {
         Self {
-            first,
-            items,
             head: vec![END; cells],
             next: Vec::new(),
             added: Vec::new(),
         }
     }
 
+    /// Adds `item` to the list of `cell`.
     pub(crate) fn push(&mut self, cell: usize, item: u32) {
         self.next.push(self.head[cell]);
         self.added.push(item);
         self.head[cell] = (self.added.len() - 1) as u32;
     }
 
+    /// The items of `cell`, the latest first.
     pub(crate) fn iter(&self, cell: usize) -> impl Iterator<Item = u32> + '_ {
-        let fixed = &self.items[self.first[cell] as usize..self.first[cell + 1] as usize];
         let mut at = self.head[cell];
-        fixed.iter().copied().chain(std::iter::from_fn(move || {
+        std::iter::from_fn(move || {
             (at != END).then(|| {
                 let x = self.added[at as usize];
                 at = self.next[at as usize];
                 x
             })
-        }))
+        })
     }
 }
 
@@ -292,7 +324,7 @@ impl SegmentIndex {
 
     /// The indices of the segments that may lie within `reach` of `p`: at least all that do.
     pub fn near(&self, p: Point) -> impl Iterator<Item = u32> + '_ {
-        self.cells.iter(self.grid.cell(p))
+        self.cells.get(self.grid.cell(p)).iter().copied()
     }
 }
 
@@ -306,10 +338,8 @@ pub(crate) fn grid_for(g: &CurveGraph) -> Grid {
 pub(crate) fn first_crossing(g: &CurveGraph) -> Option<[u32; 2]> {
     let grid = grid_for(g);
     let cells = edge_cells(g, &grid);
-    let mut list = Vec::new();
     for c in 0..grid.len() {
-        list.clear();
-        list.extend(cells.iter(c));
+        let list = cells.get(c);
         for (k, &e) in list.iter().enumerate() {
             for &f in &list[k + 1..] {
                 if conflict(

@@ -64,13 +64,18 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
     let cut: Vec<bool> = (0..n).map(is_cut).collect();
     let mut used = vec![false; edges.len()];
     let mut lines = Vec::new();
+    let mut scratch = Polyline {
+        vertices: Vec::new(),
+        edges: Vec::new(),
+        labels: [0, 0],
+    };
     for v in 0..n {
         if !cut[v as usize] {
             continue;
         }
         for &e in g.incident(v) {
             if !used[e as usize] {
-                let line = walk(g, &cut, &mut used, v, e, None);
+                let line = walk(g, &cut, &mut used, v, e, None, &mut scratch);
                 let [a, b] = line.ends();
                 if a == b {
                     // A loop hanging off a cut vertex: cut it too, keeping that vertex an end.
@@ -93,6 +98,7 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
             edges[e].ends[0],
             e as u32,
             Some(edges[e].ends[0]),
+            &mut scratch,
         );
         lines.extend(cut_loop(g, loop_line, true));
     }
@@ -108,7 +114,9 @@ fn oriented(e: GraphEdge, v: u32, leaving: bool) -> GraphEdge {
     }
 }
 
-/// Walks from `start` along `first` until a cut vertex (or back to `stop`, for a loop).
+/// Walks from `start` along `first` until a cut vertex (or back to `stop`, for a loop). The walk
+/// is gathered in `scratch` and copied out at its exact length: most polylines are short, and
+/// growing two vectors step by step would allocate several times for each.
 fn walk(
     g: &CurveGraph,
     cut: &[bool],
@@ -116,11 +124,14 @@ fn walk(
     start: u32,
     first: u32,
     stop: Option<u32>,
+    scratch: &mut Polyline,
 ) -> Polyline {
     let edges = g.edges();
     let labels = oriented(edges[first as usize], start, true).labels;
-    let mut vertices = vec![start];
-    let mut line_edges = Vec::new();
+    let (vertices, line_edges) = (&mut scratch.vertices, &mut scratch.edges);
+    vertices.clear();
+    vertices.push(start);
+    line_edges.clear();
     let (mut v, mut e) = (start, first);
     loop {
         used[e as usize] = true;
@@ -137,15 +148,15 @@ fn walk(
         }
     }
     Polyline {
-        vertices,
-        edges: line_edges,
+        vertices: vertices.clone(),
+        edges: line_edges.clone(),
         labels,
     }
 }
 
 /// Cuts a closed loop (first vertex repeated at the end) into three open pieces of about equal
 /// length, starting from its first vertex or (`reroot`) from its lowest-then-leftmost vertex.
-fn cut_loop(g: &CurveGraph, line: Polyline, reroot: bool) -> Vec<Polyline> {
+fn cut_loop(g: &CurveGraph, line: Polyline, reroot: bool) -> [Polyline; 3] {
     let m = line.edges.len();
     let lowest = |&i: &usize, &j: &usize| {
         let (p, q) = (g.point(line.vertices[i]), g.point(line.vertices[j]));
@@ -158,26 +169,33 @@ fn cut_loop(g: &CurveGraph, line: Polyline, reroot: bool) -> Vec<Polyline> {
     } else {
         0
     };
-    // Rotate so that the loop starts (and ends) at `start`.
-    let vertices: Vec<u32> = (0..=m).map(|i| line.vertices[(start + i) % m]).collect();
-    let loop_edges: Vec<u32> = (0..m).map(|i| line.edges[(start + i) % m]).collect();
-    let mut length = vec![0.0; m + 1];
-    for i in 0..m {
-        let (p, q) = (g.point(vertices[i]), g.point(vertices[i + 1]));
-        length[i + 1] = length[i] + p.distance_squared(q).sqrt();
-    }
-    let total = length[m];
+    // Walk the loop from `start`: vertex `i` of the walk is `line.vertices[(start + i) % m]`.
+    let at = |i: usize| (start + i) % m;
+    let step = |i: usize| {
+        let (p, q) = (
+            g.point(line.vertices[at(i)]),
+            g.point(line.vertices[at(i + 1)]),
+        );
+        p.distance_squared(q).sqrt()
+    };
+    let total: f64 = (0..m).map(step).sum();
     // Cut vertices at one and two thirds of the length, kept strictly inside and apart (a loop
-    // has at least three edges in a graph without duplicate edges).
-    let at = |fraction: f64| length.partition_point(|&l| l < fraction * total);
-    let c1 = at(1.0 / 3.0).clamp(1, m - 2);
-    let c2 = at(2.0 / 3.0).clamp(c1 + 1, m - 1);
-    [(0, c1), (c1, c2), (c2, m)]
-        .into_iter()
-        .map(|(i, j)| Polyline {
-            vertices: vertices[i..=j].to_vec(),
-            edges: loop_edges[i..j].to_vec(),
-            labels: line.labels,
-        })
-        .collect()
+    // has at least three edges in a graph without duplicate edges): the first vertex whose
+    // length from the start is at least that fraction of the total.
+    let (mut cuts, mut length) = ([m; 2], 0.0);
+    for i in 0..m {
+        for (cut, fraction) in cuts.iter_mut().zip([1.0 / 3.0, 2.0 / 3.0]) {
+            if *cut == m && length >= fraction * total {
+                *cut = i;
+            }
+        }
+        length += step(i);
+    }
+    let c1 = cuts[0].clamp(1, m - 2);
+    let c2 = cuts[1].clamp(c1 + 1, m - 1);
+    [(0, c1), (c1, c2), (c2, m)].map(|(i, j)| Polyline {
+        vertices: (i..=j).map(|k| line.vertices[at(k)]).collect(),
+        edges: (i..j).map(|k| line.edges[at(k)]).collect(),
+        labels: line.labels,
+    })
 }

@@ -21,7 +21,7 @@ use imesh_geom::Point;
 
 use crate::distance::segment_distance_squared;
 use crate::graph::{CurveGraph, GraphEdge};
-use crate::grid::{conflict, edge_cells, grid_for, within, CellLists, Grid};
+use crate::grid::{conflict, edge_cells, grid_for, within, CellChains, CellLists, Grid};
 use crate::polyline::{polylines, Polyline};
 use crate::CurveError;
 
@@ -93,24 +93,33 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
         return Err(CurveError::BadTolerance { tolerance });
     }
     // Cutting the polylines and indexing the graph are independent.
-    let (lines, state) = rayon::join(|| polylines(g), || State::new(g));
-    let (kept, state) = simplify_lines(&lines, state, tolerance);
-    let mut edges = Vec::new();
-    let mut chains = Vec::new();
-    let mut polyline_of = Vec::new();
-    for (index, (line, kept)) in lines.iter().zip(&kept).enumerate() {
-        for w in kept.windows(2) {
-            let (i, j) = (w[0], w[1]);
-            let chain = line.vertices[i..=j].to_vec();
-            edges.push(GraphEdge {
-                ends: [chain[0], chain[chain.len() - 1]],
-                labels: line.labels,
-            });
-            chains.push(chain);
-            polyline_of.push(index as u32);
-        }
-    }
-    let mut graph = CurveGraph::new(g.points().to_vec(), edges)?;
+    let (lines, index) = rayon::join(|| polylines(g), || Index::new(g));
+    let (kept, state) = simplify_lines(&lines, State::new(&index), tolerance);
+    let pieces = || {
+        lines
+            .iter()
+            .zip(&kept)
+            .enumerate()
+            .flat_map(|(index, (line, kept))| {
+                kept.windows(2).map(move |w| (index, line, w[0], w[1]))
+            })
+    };
+    let edges = pieces()
+        .map(|(_, line, i, j)| GraphEdge {
+            ends: [line.vertices[i], line.vertices[j]],
+            labels: line.labels,
+        })
+        .collect();
+    // Indexing G' and copying out the chains are independent.
+    let (graph, (chains, polyline_of)) = rayon::join(
+        || CurveGraph::new(g.points().to_vec(), edges),
+        || {
+            pieces()
+                .map(|(index, line, i, j)| (line.vertices[i..=j].to_vec(), index as u32))
+                .unzip()
+        },
+    );
+    let mut graph = graph?;
     for line in &lines {
         for v in line.ends() {
             graph.pin(v)?;
@@ -136,11 +145,11 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
 /// against its own copy of the graph, side by side, the copies are merged, and the polylines
 /// that cross the line come last. The result is that of simplifying the left side, then the
 /// right side, then the rest, one after the other — the same on any number of threads.
-fn simplify_lines<'g>(
+fn simplify_lines<'a>(
     lines: &[Polyline],
-    mut state: State<'g>,
+    mut state: State<'a>,
     tolerance: f64,
-) -> (Vec<Vec<usize>>, State<'g>) {
+) -> (Vec<Vec<usize>>, State<'a>) {
     let points = state.g.points();
     let extent: Vec<[f64; 2]> = lines
         .iter()
@@ -167,7 +176,7 @@ fn simplify_lines<'g>(
     }
     let mut kept = vec![Vec::new(); lines.len()];
     let mut right = state.clone();
-    let run = |state: &mut State<'g>, ids: &[usize]| -> Vec<Vec<usize>> {
+    let run = |state: &mut State<'a>, ids: &[usize]| -> Vec<Vec<usize>> {
         ids.iter()
             .map(|&k| state.simplify_line(&lines[k], tolerance))
             .collect()
@@ -184,56 +193,72 @@ fn simplify_lines<'g>(
     (kept, state)
 }
 
-/// The current graph during simplification: every edge (original, or a chord that replaced a
-/// chain) with a liveness flag, the live vertices, and the grid over both.
-#[derive(Clone)]
-struct State<'g> {
+/// The input graph indexed for the topology tests: its edges and its live vertices by grid
+/// cell. It never changes, so every [`State`] shares it.
+struct Index<'g> {
     g: &'g CurveGraph,
     grid: Grid,
-    ends: Vec<[u32; 2]>,
-    alive: Vec<bool>,
     edge_cells: CellLists,
-    vertex_alive: Vec<bool>,
-    /// Vertices of each cell, compressed (`vertex_list[vertex_first[c]..vertex_first[c + 1]]`).
-    vertex_first: Vec<u32>,
-    vertex_list: Vec<u32>,
-    /// Per-edge and per-vertex stamps: "seen in this query", "in the chain under test".
-    edge_seen: Vec<u32>,
-    edge_in_chain: Vec<u32>,
-    vertex_seen: Vec<u32>,
-    vertex_in_chain: Vec<u32>,
+    /// The initially live vertices of each cell, with their points alongside so that a query's
+    /// box test reads the cell's memory only.
+    vertex_cells: CellLists<(u32, Point)>,
+}
+
+impl<'g> Index<'g> {
+    fn new(g: &'g CurveGraph) -> Self {
+        let grid = grid_for(g);
+        // The edge lists and the vertex lists are independent: build them side by side.
+        let (edge_cells, vertex_cells) =
+            rayon::join(|| edge_cells(g, &grid), || vertex_cells(g, &grid));
+        Self {
+            g,
+            grid,
+            edge_cells,
+            vertex_cells,
+        }
+    }
+}
+
+/// The current graph during simplification: the input's edges and the chords that replaced
+/// some of them (edge `m + k` is chord `k`, for `m` input edges), which of them are live, and
+/// which vertices are.
+#[derive(Clone)]
+struct State<'a> {
+    index: &'a Index<'a>,
+    g: &'a CurveGraph,
+    chords: Vec<[u32; 2]>,
+    chord_cells: CellChains,
+    /// One stamp per edge and per vertex, so that a query reads one word per candidate:
+    /// [`REMOVED`] once it has left the graph; the current query's number while it is in the
+    /// curve under test (and, for an edge, once the query has seen it: an edge crosses several
+    /// cells, a vertex lies in one).
+    edge_mark: Vec<u32>,
+    vertex_mark: Vec<u32>,
     query: u32,
+    /// Buffers reused from one polyline to the next (most polylines are a few edges long, so
+    /// allocating these per polyline would cost more than the work on them).
+    scratch: Scratch,
     refused: usize,
     merged: usize,
     /// The largest distance from a removed vertex to its chord.
     max_deviation: f64,
 }
 
-impl<'g> State<'g> {
-    fn new(g: &'g CurveGraph) -> Self {
-        let grid = grid_for(g);
-        let n = g.points().len();
-        let vertex_alive: Vec<bool> = (0..n as u32).map(|v| g.valence(v) > 0).collect();
-        // The edge lists and the vertex lists are independent: build them side by side.
-        let (edge_cells, (vertex_first, vertex_list)) = rayon::join(
-            || edge_cells(g, &grid),
-            || vertex_cells(g, &grid, &vertex_alive),
-        );
-        let m = g.edges().len();
+impl<'a> State<'a> {
+    fn new(index: &'a Index<'a>) -> Self {
+        let g = index.g;
+        let vertex_mark = (0..g.points().len() as u32)
+            .map(|v| if g.valence(v) > 0 { 0 } else { REMOVED })
+            .collect();
         Self {
+            index,
             g,
-            grid,
-            ends: g.edges().iter().map(|e| e.ends).collect(),
-            alive: vec![true; m],
-            edge_cells,
-            vertex_alive,
-            vertex_first,
-            vertex_list,
-            edge_seen: vec![0; m],
-            edge_in_chain: vec![0; m],
-            vertex_seen: vec![0; n],
-            vertex_in_chain: vec![0; n],
+            chords: Vec::new(),
+            chord_cells: CellChains::new(index.grid.len()),
+            edge_mark: vec![0; g.edges().len()],
+            vertex_mark,
             query: 0,
+            scratch: Scratch::default(),
             refused: 0,
             merged: 0,
             max_deviation: 0.0,
@@ -243,12 +268,19 @@ impl<'g> State<'g> {
     /// Douglas–Peucker on one polyline; returns the indices (into `line.vertices`) kept.
     fn simplify_line(&mut self, line: &Polyline, tolerance: f64) -> Vec<usize> {
         let v = &line.vertices;
-        let mut keep = vec![false; v.len()];
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let Scratch {
+            keep, piece, stack, ..
+        } = &mut scratch;
+        keep.clear();
+        keep.resize(v.len(), false);
         keep[0] = true;
         keep[v.len() - 1] = true;
         // The current edge of the piece starting at each kept vertex.
-        let mut piece = vec![u32::MAX; v.len()];
-        let mut stack = vec![(0, v.len() - 1)];
+        piece.clear();
+        piece.resize(v.len(), u32::MAX);
+        stack.clear();
+        stack.push((0, v.len() - 1));
         while let Some((i, j)) = stack.pop() {
             if j <= i + 1 {
                 if j == i + 1 {
@@ -279,10 +311,13 @@ impl<'g> State<'g> {
             stack.push((i, far));
         }
         let kept: Vec<usize> = (0..v.len()).filter(|&k| keep[k]).collect();
-        if kept.len() <= 2 {
-            return kept;
-        }
-        self.merge_pieces(line, &kept, &piece, tolerance)
+        let kept = if kept.len() <= 2 {
+            kept
+        } else {
+            self.merge_pieces(line, &kept, &mut scratch, tolerance)
+        };
+        self.scratch = scratch;
+        kept
     }
 
     /// The two tests of the module documentation for the chord `v[i] v[j]` replacing the chain
@@ -306,10 +341,12 @@ impl<'g> State<'g> {
         self.query += 1;
         let q = self.query;
         for &e in edges {
-            self.edge_in_chain[e as usize] = q;
+            self.edge_mark[e as usize] = q;
         }
         for &x in own {
-            self.vertex_in_chain[x as usize] = q;
+            if self.vertex_mark[x as usize] != REMOVED {
+                self.vertex_mark[x as usize] = q;
+            }
         }
         let chord = [chain[0], chain[chain.len() - 1]];
         let points = self.g.points();
@@ -318,19 +355,21 @@ impl<'g> State<'g> {
         // 1. The chord meets no other current edge (the bounding boxes must overlap first).
         let (lo, hi) = bounding_box([a, b].into_iter());
         let mut safe = true;
-        let (edge_cells, ends, alive) = (&self.edge_cells, &self.ends, &self.alive);
-        let (edge_seen, edge_in_chain) = (&mut self.edge_seen, &self.edge_in_chain);
-        self.grid.cells_near_segment(a, b, 0.0, |c| {
+        let (index, chords, chord_cells) = (self.index, &self.chords, &self.chord_cells);
+        let (input, m) = (self.g.edges(), self.g.edges().len());
+        let edge_mark = &mut self.edge_mark;
+        index.grid.cells_near_segment(a, b, 0.0, |c| {
             if !safe {
                 return;
             }
-            for e in edge_cells.iter(c) {
+            let edges = index.edge_cells.get(c).iter().copied();
+            for e in edges.chain(chord_cells.iter(c)) {
                 let e = e as usize;
-                if edge_seen[e] == q || !alive[e] || edge_in_chain[e] == q {
+                if edge_mark[e] == q || edge_mark[e] == REMOVED {
                     continue;
                 }
-                edge_seen[e] = q;
-                let [u, w] = ends[e];
+                edge_mark[e] = q;
+                let [u, w] = if e < m { input[e].ends } else { chords[e - m] };
                 let (pu, pw) = (points[u as usize], points[w as usize]);
                 if pu.x.max(pw.x) < lo.x
                     || pu.x.min(pw.x) > hi.x
@@ -339,7 +378,7 @@ impl<'g> State<'g> {
                 {
                     continue;
                 }
-                if conflict(points, chord, ends[e]) {
+                if conflict(points, chord, [u, w]) {
                     safe = false;
                     return;
                 }
@@ -351,23 +390,18 @@ impl<'g> State<'g> {
 
         // 2. No other current vertex in the region between the chain and the chord.
         let (lo, hi) = bounding_box(chain.iter().map(|&x| points[x as usize]));
-        let (vertex_first, vertex_list) = (&self.vertex_first, &self.vertex_list);
-        let (vertex_alive, vertex_in_chain) = (&self.vertex_alive, &self.vertex_in_chain);
-        let vertex_seen = &mut self.vertex_seen;
+        let vertex_mark = &self.vertex_mark;
         let pad = deviation * (1.0 + 1e-12) + 1e-12;
-        self.grid.cells_near_segment(a, b, pad, |c| {
+        index.grid.cells_near_segment(a, b, pad, |c| {
             if !safe {
                 return;
             }
-            let list = &vertex_list[vertex_first[c] as usize..vertex_first[c + 1] as usize];
-            for &x in list {
-                let xi = x as usize;
-                if vertex_seen[xi] == q || !vertex_alive[xi] || vertex_in_chain[xi] == q {
+            for &(x, p) in index.vertex_cells.get(c) {
+                if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
                     continue;
                 }
-                vertex_seen[xi] = q;
-                let p = points[xi];
-                if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+                let mark = vertex_mark[x as usize];
+                if mark == q || mark == REMOVED {
                     continue;
                 }
                 if encloses(points, chain, p) {
@@ -388,10 +422,10 @@ impl<'g> State<'g> {
     /// Removes `edges` and `vertices` from the current graph.
     fn replace_edges(&mut self, edges: &[u32], vertices: &[u32]) {
         for &e in edges {
-            self.alive[e as usize] = false;
+            self.edge_mark[e as usize] = REMOVED;
         }
         for &x in vertices {
-            self.vertex_alive[x as usize] = false;
+            self.vertex_mark[x as usize] = REMOVED;
         }
     }
 
@@ -407,9 +441,15 @@ impl<'g> State<'g> {
         &mut self,
         line: &Polyline,
         kept: &[usize],
-        piece: &[u32],
+        scratch: &mut Scratch,
         tolerance: f64,
     ) -> Vec<usize> {
+        let Scratch {
+            piece,
+            curve,
+            edges,
+            ..
+        } = scratch;
         let v = &line.vertices;
         let points = self.g.points();
         let mut out = vec![kept[0]];
@@ -427,17 +467,21 @@ impl<'g> State<'g> {
                 if deviation > tolerance {
                     continue;
                 }
-                let curve: Vec<u32> = kept[a..=b].iter().map(|&k| v[k]).collect();
-                let edges: Vec<u32> = kept[a..b].iter().map(|&k| piece[k]).collect();
-                if self.shortcut_is_safe(&curve, &edges, &v[i..=j], deviation) {
+                curve.clear();
+                curve.extend(kept[a..=b].iter().map(|&k| v[k]));
+                edges.clear();
+                edges.extend(kept[a..b].iter().map(|&k| piece[k]));
+                if self.shortcut_is_safe(curve, edges, &v[i..=j], deviation) {
                     best = (b, deviation);
                 }
             }
             let (b, deviation) = best;
             if b > a + 1 {
-                let edges: Vec<u32> = kept[a..b].iter().map(|&k| piece[k]).collect();
-                let inner: Vec<u32> = kept[a + 1..b].iter().map(|&k| v[k]).collect();
-                self.replace_edges(&edges, &inner);
+                edges.clear();
+                edges.extend(kept[a..b].iter().map(|&k| piece[k]));
+                curve.clear();
+                curve.extend(kept[a + 1..b].iter().map(|&k| v[k]));
+                self.replace_edges(edges, curve);
                 self.add_chord([v[kept[a]], v[kept[b]]]);
                 self.max_deviation = self.max_deviation.max(deviation);
                 self.merged += b - a - 1;
@@ -451,10 +495,11 @@ impl<'g> State<'g> {
     /// A vertical line `x = split` (a grid column boundary) with about as many polyline vertices
     /// wholly on either side, given each polyline's x-extent.
     fn balanced_split(&self, lines: &[Polyline], extent: &[[f64; 2]]) -> f64 {
-        let columns = self.grid.columns();
+        let grid = &self.index.grid;
+        let columns = grid.columns();
         let mut weight = vec![0usize; columns + 1];
         for (line, &[lo, hi]) in lines.iter().zip(extent) {
-            weight[self.grid.column(0.5 * (lo + hi))] += line.vertices.len();
+            weight[grid.column(0.5 * (lo + hi))] += line.vertices.len();
         }
         let half = weight.iter().sum::<usize>() / 2;
         let mut sum = 0;
@@ -465,21 +510,24 @@ impl<'g> State<'g> {
                 sum >= half
             })
             .unwrap_or(0);
-        self.grid.column_start(column + 1)
+        grid.column_start(column + 1)
     }
 
     /// Takes in what `other`, a copy of this state from before any simplification, did: the
-    /// edges and vertices it removed and the chords it added.
+    /// edges and vertices it removed and the chords it added and kept.
     fn absorb(&mut self, other: &State<'_>) {
         let m = self.g.edges().len();
-        for (alive, &there) in self.alive[..m].iter_mut().zip(&other.alive[..m]) {
-            *alive &= there;
+        let marks = self.edge_mark[..m].iter_mut().zip(&other.edge_mark[..m]);
+        for (mark, &there) in marks.chain(self.vertex_mark.iter_mut().zip(&other.vertex_mark)) {
+            if there == REMOVED {
+                *mark = REMOVED;
+            }
         }
-        for (alive, &there) in self.vertex_alive.iter_mut().zip(&other.vertex_alive) {
-            *alive &= there;
-        }
-        for &chord in &other.ends[m..] {
-            self.add_chord(chord);
+        // Only the chords still live there: the second pass replaces some of the first's.
+        for (&chord, &mark) in other.chords.iter().zip(&other.edge_mark[m..]) {
+            if mark != REMOVED {
+                self.add_chord(chord);
+            }
         }
         self.merged += other.merged;
         self.refused += other.refused;
@@ -488,18 +536,34 @@ impl<'g> State<'g> {
 
     /// Adds the chord `chord` to the current graph.
     fn add_chord(&mut self, chord: [u32; 2]) -> u32 {
-        let id = self.ends.len() as u32;
-        self.ends.push(chord);
-        self.alive.push(true);
-        self.edge_seen.push(0);
-        self.edge_in_chain.push(0);
+        let id = self.edge_mark.len() as u32;
+        self.chords.push(chord);
+        self.edge_mark.push(0);
         let (a, b) = (self.g.point(chord[0]), self.g.point(chord[1]));
-        let cells = &mut self.edge_cells;
-        self.grid
+        let cells = &mut self.chord_cells;
+        self.index
+            .grid
             .cells_near_segment(a, b, 0.0, |c| cells.push(c, id));
         id
     }
 }
+
+/// Work buffers of [`State::simplify_line`] and [`State::merge_pieces`].
+#[derive(Clone, Default)]
+struct Scratch {
+    /// Per vertex of the polyline: kept by Douglas–Peucker.
+    keep: Vec<bool>,
+    /// Per kept vertex of the polyline: the current edge of the piece that starts there.
+    piece: Vec<u32>,
+    /// Douglas–Peucker's pending index ranges.
+    stack: Vec<(usize, usize)>,
+    /// A curve under test (vertex ids) and its current edges.
+    curve: Vec<u32>,
+    edges: Vec<u32>,
+}
+
+/// The stamp of an edge or a vertex that has left the current graph (see `State::edge_mark`).
+const REMOVED: u32 = u32::MAX;
 
 /// True when every vertex of the chain lies exactly on the segment between its ends: the chord
 /// is then the chain itself as a point set, and replacing one by the other changes nothing.
@@ -514,25 +578,13 @@ fn straight(points: &[Point], chain: &[u32]) -> bool {
         .all(|&v| orient2d(a, b, points[v as usize]) == 0.0)
 }
 
-/// The live vertices of each grid cell, compressed: those of cell `c` are
-/// `list[first[c]..first[c + 1]]`.
-fn vertex_cells(g: &CurveGraph, grid: &Grid, alive: &[bool]) -> (Vec<u32>, Vec<u32>) {
-    let points = g.points();
-    let mut first = vec![0u32; grid.len() + 1];
-    for v in (0..points.len()).filter(|&v| alive[v]) {
-        first[grid.cell(points[v]) + 1] += 1;
-    }
-    for c in 0..grid.len() {
-        first[c + 1] += first[c];
-    }
-    let mut fill = first.clone();
-    let mut list = vec![0u32; first[grid.len()] as usize];
-    for v in (0..points.len()).filter(|&v| alive[v]) {
-        let c = grid.cell(points[v]);
-        list[fill[c] as usize] = v as u32;
-        fill[c] += 1;
-    }
-    (first, list)
+/// The vertices of each grid cell that some edge ends at, with their points.
+fn vertex_cells(g: &CurveGraph, grid: &Grid) -> CellLists<(u32, Point)> {
+    let pairs: Vec<(u32, (u32, Point))> = (0..g.points().len() as u32)
+        .filter(|&v| g.valence(v) > 0)
+        .map(|v| (grid.cell(g.point(v)) as u32, (v, g.point(v))))
+        .collect();
+    CellLists::new(grid.len(), &pairs)
 }
 
 fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
