@@ -224,6 +224,8 @@ pub(crate) struct CellChains {
     head: Vec<u32>,
     next: Vec<u32>,
     added: Vec<u32>,
+    /// The cell of each entry of `added`.
+    cell: Vec<u32>,
 }
 
 const END: u32 = u32::MAX;
@@ -235,6 +237,7 @@ impl CellChains {
             head: vec![END; cells],
             next: Vec::new(),
             added: Vec::new(),
+            cell: Vec::new(),
         }
     }
 
@@ -242,7 +245,16 @@ impl CellChains {
     pub(crate) fn push(&mut self, cell: usize, item: u32) {
         self.next.push(self.head[cell]);
         self.added.push(item);
+        self.cell.push(cell as u32);
         self.head[cell] = (self.added.len() - 1) as u32;
+    }
+
+    /// Every `(cell, item)` pair, in the order they were added.
+    pub(crate) fn entries(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
+        self.cell
+            .iter()
+            .map(|&c| c as usize)
+            .zip(self.added.iter().copied())
     }
 
     /// The items of `cell`, the latest first.

@@ -18,6 +18,7 @@
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
+use rayon::prelude::*;
 
 use crate::distance::segment_distance_squared;
 use crate::graph::{CurveGraph, GraphEdge};
@@ -152,7 +153,7 @@ fn simplify_lines<'a>(
 ) -> (Vec<Vec<usize>>, State<'a>) {
     let points = state.g.points();
     let extent: Vec<[f64; 2]> = lines
-        .iter()
+        .par_iter()
         .map(|line| {
             line.vertices
                 .iter()
@@ -523,10 +524,21 @@ impl<'a> State<'a> {
                 *mark = REMOVED;
             }
         }
-        // Only the chords still live there: the second pass replaces some of the first's.
-        for (&chord, &mark) in other.chords.iter().zip(&other.edge_mark[m..]) {
+        // Only the chords still live there (the second pass replaces some of the first's), in
+        // the cells the other state found for them. Their ids there are `m + k` for chord `k`;
+        // here they follow this state's own.
+        let mut id = vec![REMOVED; other.chords.len()];
+        for (k, (&chord, &mark)) in other.chords.iter().zip(&other.edge_mark[m..]).enumerate() {
             if mark != REMOVED {
-                self.add_chord(chord);
+                id[k] = self.edge_mark.len() as u32;
+                self.chords.push(chord);
+                self.edge_mark.push(0);
+            }
+        }
+        for (cell, e) in other.chord_cells.entries() {
+            let e = id[e as usize - m];
+            if e != REMOVED {
+                self.chord_cells.push(cell, e);
             }
         }
         self.merged += other.merged;
