@@ -393,6 +393,7 @@ impl<'a> State<'a> {
         let (lo, hi) = bounding_box(chain.iter().map(|&x| points[x as usize]));
         let vertex_mark = &self.vertex_mark;
         let pad = deviation * (1.0 + 1e-12) + 1e-12;
+        let reach2 = (deviation * (1.0 + 1e-9) + 1e-9).powi(2);
         index.grid.cells_near_segment(a, b, pad, |c| {
             if !safe {
                 return;
@@ -403,6 +404,12 @@ impl<'a> State<'a> {
                 }
                 let mark = vertex_mark[x as usize];
                 if mark == q || mark == REMOVED {
+                    continue;
+                }
+                // The region lies within `deviation` of the chord (the distance to a segment is
+                // convex, so its largest value on the region is at a chain vertex): a point
+                // clearly farther away is outside, without walking the chain.
+                if segment_distance_squared(a, b, p) > reach2 {
                     continue;
                 }
                 if encloses(points, chain, p) {
