@@ -141,17 +141,14 @@ fn solve(
     }
     let size = (area / scratch.corners.len() as f64).abs().sqrt();
     let (best, cost) = match setup.local_solver {
-        LocalSolver::Powell => {
-            let powell = Powell::new(0.2 * size)
-                .with_tolerance(1e-4)
-                .with_line_search(1e-2, 10);
-            let result = Executor::new(local, powell)
-                .configure(|s| s.param(vec![0.0, 0.0]).max_iters(setup.local_iterations))
-                .run()
-                .ok()?;
-            let state = result.state();
-            (state.get_best_param()?.clone(), state.get_best_cost())
-        }
+        LocalSolver::Powell => Powell::new(0.2 * size)
+            .with_tolerance(1e-4)
+            .with_line_search(1e-2, 10)
+            .minimise(
+                |x| local.energy(Point::new(x[0], x[1])),
+                vec![0.0, 0.0],
+                setup.local_iterations,
+            ),
         LocalSolver::Lbfgs => {
             let line = BacktrackingLineSearch::new(ArmijoCondition::new(1e-4).ok()?);
             let lbfgs = LBFGS::new(line, 3);

@@ -22,12 +22,19 @@ enum Direction {
 impl Direction {
     /// `x + α d`.
     fn step(&self, x: &[f64], alpha: f64) -> Vec<f64> {
-        let mut y = x.to_vec();
+        let mut y = Vec::with_capacity(x.len());
+        self.step_into(x, alpha, &mut y);
+        y
+    }
+
+    /// `x + α d`, written into `y` (a line search evaluates many steps: one buffer serves all).
+    fn step_into(&self, x: &[f64], alpha: f64, y: &mut Vec<f64>) {
+        y.clear();
+        y.extend_from_slice(x);
         match self {
             Direction::Axis(i) => y[*i] += alpha,
             Direction::Dense(d) => y.iter_mut().zip(d).for_each(|(y, d)| *y += alpha * d),
         }
-        y
     }
 }
 
@@ -36,6 +43,7 @@ impl Direction {
 /// The state's cost is the value at the state's parameter; every iteration runs one line search
 /// per direction, then possibly one along the net displacement. It stops when an iteration
 /// lowers the cost by less than `tolerance` relatively, or at the executor's iteration cap.
+/// [`Powell::minimise`] runs the same iterations on a plain cost closure, without an executor.
 ///
 /// ```
 /// use argmin::core::{CostFunction, Error, Executor};
@@ -104,20 +112,19 @@ impl Powell {
 
     /// Minimises along `d` from `x` (cost `fx`): returns the best step and its cost (`(0, fx)`
     /// when no step along `±d` lowers the cost).
-    fn line_minimum<O>(
+    fn line_minimum(
         &self,
-        problem: &mut Problem<O>,
+        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, Error>,
         x: &[f64],
         d: &Direction,
         fx: f64,
-    ) -> Result<(f64, f64), Error>
-    where
-        O: CostFunction<Param = Vec<f64>, Output = f64>,
-    {
+    ) -> Result<(f64, f64), Error> {
         let mut budget = self.line_evaluations;
+        let mut y = Vec::with_capacity(x.len());
         let mut f = |alpha: f64, budget: &mut usize| -> Result<f64, Error> {
             *budget = budget.saturating_sub(1);
-            let c = problem.cost(&d.step(x, alpha))?;
+            d.step_into(x, alpha, &mut y);
+            let c = cost(&y)?;
             Ok(if c.is_nan() { f64::INFINITY } else { c })
         };
         // Bracket: find a downhill step (shrinking it past infeasible or uphill points), then
@@ -222,6 +229,93 @@ impl Powell {
         }
         Ok((xb, fxb))
     }
+
+    /// One iteration from `x0` (cost `f0`): a line search along each direction, then possibly
+    /// one along the net displacement, which may replace the direction of largest decrease.
+    fn iterate(
+        &mut self,
+        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, Error>,
+        x0: Vec<f64>,
+        f0: f64,
+    ) -> Result<(Vec<f64>, f64), Error> {
+        let (mut x, mut fx) = (x0.clone(), f0);
+        let (mut biggest, mut biggest_at) = (0.0, 0);
+        for (i, d) in self.directions.iter().enumerate() {
+            let (alpha, f) = self.line_minimum(cost, &x, d, fx)?;
+            if f < fx {
+                x = d.step(&x, alpha);
+                if fx - f > biggest {
+                    (biggest, biggest_at) = (fx - f, i);
+                }
+                fx = f;
+            }
+        }
+        // Extrapolate along the net displacement; adopt it as a direction only when Powell's test
+        // says the set stays conjugate (the largest single decrease did not dominate).
+        if fx < f0 {
+            let displacement: Vec<f64> = x.iter().zip(&x0).map(|(a, b)| a - b).collect();
+            let extrapolated: Vec<f64> = x.iter().zip(&displacement).map(|(a, d)| a + d).collect();
+            let fe = cost(&extrapolated)?;
+            if fe < f0 {
+                let t = 2.0 * (f0 - 2.0 * fx + fe) * (f0 - fx - biggest).powi(2)
+                    - biggest * (f0 - fe).powi(2);
+                if t < 0.0 {
+                    let d = Direction::Dense(displacement);
+                    let (alpha, f) = self.line_minimum(cost, &x, &d, fx)?;
+                    if f < fx {
+                        x = d.step(&x, alpha);
+                        fx = f;
+                    }
+                    self.directions.remove(biggest_at);
+                    self.directions.push(d);
+                }
+            }
+        }
+        Ok((x, fx))
+    }
+
+    /// Whether an iteration from cost `f0` to `f` lowered it by less than the tolerance (or left
+    /// it infinite).
+    fn converged(&self, f0: f64, f: f64) -> bool {
+        !f.is_finite() || 2.0 * (f0 - f) <= self.tolerance * (f0.abs() + f.abs()) + 1e-300
+    }
+
+    /// Minimises `cost` from `x0` by at most `max_iters` iterations, stopping as the argmin
+    /// executor would (at convergence or at the cap), and returns the point reached and its
+    /// cost. The same iterations as running the solver in an [`argmin::core::Executor`], without
+    /// the executor's bookkeeping (per-evaluation counters, state copies): for the many tiny
+    /// problems of the local optimiser, where that bookkeeping costs as much as the problem.
+    ///
+    /// ```
+    /// use imesh_optim::Powell;
+    /// let quadratic = |x: &Vec<f64>| (x[0] - 1.0).powi(2) + 2.0 * (x[1] + 0.5).powi(2);
+    /// let (x, f) = Powell::new(0.1).minimise(quadratic, vec![0.0, 0.0], 50);
+    /// assert!((x[0] - 1.0).abs() < 1e-6 && (x[1] + 0.5).abs() < 1e-6 && f < 1e-10);
+    /// ```
+    pub fn minimise(
+        mut self,
+        mut cost: impl FnMut(&Vec<f64>) -> f64,
+        x0: Vec<f64>,
+        max_iters: u64,
+    ) -> (Vec<f64>, f64) {
+        let mut cost = |x: &Vec<f64>| -> Result<f64, Error> { Ok(cost(x)) };
+        let (mut x, mut fx) = (x0, f64::INFINITY);
+        if let Ok(f) = cost(&x) {
+            fx = f;
+        }
+        self.directions = (0..x.len()).map(Direction::Axis).collect();
+        let mut previous = f64::INFINITY;
+        for iter in 0..max_iters {
+            if iter > 0 && self.converged(previous, fx) {
+                break;
+            }
+            let Ok((next, f)) = self.iterate(&mut cost, x.clone(), fx) else {
+                break;
+            };
+            (x, previous, fx) = (next, fx, f);
+        }
+        (x, fx)
+    }
 }
 
 impl<O> Solver<O, IterState<Vec<f64>, (), (), (), (), f64>> for Powell
@@ -255,48 +349,12 @@ where
             .take_param()
             .ok_or_else(|| Error::msg("Powell lost its parameter vector"))?;
         let f0 = state.get_cost();
-        let (mut x, mut fx) = (x0.clone(), f0);
-        let (mut biggest, mut biggest_at) = (0.0, 0);
-        for (i, d) in self.directions.iter().enumerate() {
-            let (alpha, f) = self.line_minimum(problem, &x, d, fx)?;
-            if f < fx {
-                x = d.step(&x, alpha);
-                if fx - f > biggest {
-                    (biggest, biggest_at) = (fx - f, i);
-                }
-                fx = f;
-            }
-        }
-        // Extrapolate along the net displacement; adopt it as a direction only when Powell's test
-        // says the set stays conjugate (the largest single decrease did not dominate).
-        if fx < f0 {
-            let displacement: Vec<f64> = x.iter().zip(&x0).map(|(a, b)| a - b).collect();
-            let extrapolated: Vec<f64> = x.iter().zip(&displacement).map(|(a, d)| a + d).collect();
-            let fe = problem.cost(&extrapolated)?;
-            if fe < f0 {
-                let t = 2.0 * (f0 - 2.0 * fx + fe) * (f0 - fx - biggest).powi(2)
-                    - biggest * (f0 - fe).powi(2);
-                if t < 0.0 {
-                    let d = Direction::Dense(displacement);
-                    let (alpha, f) = self.line_minimum(problem, &x, &d, fx)?;
-                    if f < fx {
-                        x = d.step(&x, alpha);
-                        fx = f;
-                    }
-                    self.directions.remove(biggest_at);
-                    self.directions.push(d);
-                }
-            }
-        }
+        let (x, fx) = self.iterate(&mut |x| problem.cost(x), x0, f0)?;
         Ok((state.param(x).cost(fx), None))
     }
 
     fn terminate(&mut self, state: &IterState<Vec<f64>, (), (), (), (), f64>) -> TerminationStatus {
-        if state.get_iter() == 0 {
-            return TerminationStatus::NotTerminated;
-        }
-        let (f0, f) = (state.get_prev_cost(), state.get_cost());
-        if !f.is_finite() || 2.0 * (f0 - f) <= self.tolerance * (f0.abs() + f.abs()) + 1e-300 {
+        if state.get_iter() > 0 && self.converged(state.get_prev_cost(), state.get_cost()) {
             return TerminationStatus::Terminated(TerminationReason::SolverConverged);
         }
         TerminationStatus::NotTerminated

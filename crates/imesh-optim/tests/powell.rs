@@ -1,8 +1,9 @@
-//! Powell's method on the classic test functions, through argmin's executor.
+//! Powell's method on the classic test functions, through argmin's executor and directly.
 
 use argmin::core::{CostFunction, Error, Executor, State};
 use imesh_optim::Powell;
 
+#[derive(Clone)]
 struct Rosenbrock;
 
 impl CostFunction for Rosenbrock {
@@ -14,6 +15,7 @@ impl CostFunction for Rosenbrock {
 }
 
 /// `(x − c)ᵀ A (x − c)` with a dense, badly conditioned positive definite `A`.
+#[derive(Clone)]
 struct Quadratic {
     a: Vec<Vec<f64>>,
     centre: Vec<f64>,
@@ -55,6 +57,7 @@ impl CostFunction for Quadratic {
 }
 
 /// `(x₀ − 2)² + (x₁ + 1)²`, infinite (infeasible) where `x₀ > 1`.
+#[derive(Clone)]
 struct Fenced;
 
 impl CostFunction for Fenced {
@@ -130,4 +133,49 @@ fn powell_never_returns_a_worse_point_than_the_start() {
         .unwrap();
     assert_eq!(result.state().get_best_cost(), 0.0);
     assert_eq!(result.state().get_best_param().unwrap(), &vec![1.0, 1.0]);
+}
+
+/// Runs `powell` on `problem` from `start` for at most `iterations` both through argmin's
+/// executor and through [`Powell::minimise`].
+fn both_ways<O>(
+    problem: O,
+    powell: Powell,
+    start: Vec<f64>,
+    iterations: u64,
+) -> [(Vec<f64>, f64); 2]
+where
+    O: CostFunction<Param = Vec<f64>, Output = f64> + Clone,
+{
+    let result = Executor::new(problem.clone(), powell.clone())
+        .configure(|s| s.param(start.clone()).max_iters(iterations))
+        .run()
+        .unwrap();
+    let state = result.state();
+    let executor = (
+        state.get_best_param().unwrap().clone(),
+        state.get_best_cost(),
+    );
+    let direct = powell.minimise(|x| problem.cost(x).unwrap(), start, iterations);
+    [executor, direct]
+}
+
+#[test]
+fn minimise_takes_the_executors_steps_exactly() {
+    // The local optimiser relies on it: same iterates, same stopping, bit for bit.
+    for iterations in [1, 2, 5, 500] {
+        let [a, b] = both_ways(Rosenbrock, Powell::new(0.5), vec![-1.2, 1.0], iterations);
+        assert_eq!(a, b, "Rosenbrock, {iterations} iterations");
+        let [a, b] = both_ways(
+            Quadratic::new(5),
+            Powell::new(1.0),
+            vec![0.0; 5],
+            iterations,
+        );
+        assert_eq!(a, b, "quadratic, {iterations} iterations");
+        let local = Powell::new(0.3)
+            .with_tolerance(1e-4)
+            .with_line_search(1e-2, 10);
+        let [a, b] = both_ways(Fenced, local, vec![0.0, 0.0], iterations);
+        assert_eq!(a, b, "fenced, {iterations} iterations");
+    }
 }
