@@ -75,13 +75,13 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
         }
         for &e in g.incident(v) {
             if !used[e as usize] {
-                let line = walk(g, &cut, &mut used, v, e, None, &mut scratch);
-                let [a, b] = line.ends();
+                walk(g, &cut, &mut used, v, e, None, &mut scratch);
+                let [a, b] = scratch.ends();
                 if a == b {
                     // A loop hanging off a cut vertex: cut it too, keeping that vertex an end.
-                    lines.extend(cut_loop(g, line, false));
+                    lines.extend(cut_loop(g, &scratch, false));
                 } else {
-                    lines.push(line);
+                    lines.push(scratch.clone());
                 }
             }
         }
@@ -91,7 +91,7 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
         if used[e] {
             continue;
         }
-        let loop_line = walk(
+        walk(
             g,
             &cut,
             &mut used,
@@ -100,7 +100,7 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
             Some(edges[e].ends[0]),
             &mut scratch,
         );
-        lines.extend(cut_loop(g, loop_line, true));
+        lines.extend(cut_loop(g, &scratch, true));
     }
     lines
 }
@@ -114,9 +114,10 @@ fn oriented(e: GraphEdge, v: u32, leaving: bool) -> GraphEdge {
     }
 }
 
-/// Walks from `start` along `first` until a cut vertex (or back to `stop`, for a loop). The walk
-/// is gathered in `scratch` and copied out at its exact length: most polylines are short, and
-/// growing two vectors step by step would allocate several times for each.
+/// Walks from `start` along `first` until a cut vertex (or back to `stop`, for a loop), into
+/// `line`: one buffer serves every walk, and a caller copies out what it keeps at its exact
+/// length (most polylines are short: growing two vectors step by step would allocate several
+/// times for each).
 fn walk(
     g: &CurveGraph,
     cut: &[bool],
@@ -124,11 +125,11 @@ fn walk(
     start: u32,
     first: u32,
     stop: Option<u32>,
-    scratch: &mut Polyline,
-) -> Polyline {
+    line: &mut Polyline,
+) {
     let edges = g.edges();
-    let labels = oriented(edges[first as usize], start, true).labels;
-    let (vertices, line_edges) = (&mut scratch.vertices, &mut scratch.edges);
+    line.labels = oriented(edges[first as usize], start, true).labels;
+    let (vertices, line_edges) = (&mut line.vertices, &mut line.edges);
     vertices.clear();
     vertices.push(start);
     line_edges.clear();
@@ -147,16 +148,11 @@ fn walk(
             _ => break,
         }
     }
-    Polyline {
-        vertices: vertices.clone(),
-        edges: line_edges.clone(),
-        labels,
-    }
 }
 
 /// Cuts a closed loop (first vertex repeated at the end) into three open pieces of about equal
 /// length, starting from its first vertex or (`reroot`) from its lowest-then-leftmost vertex.
-fn cut_loop(g: &CurveGraph, line: Polyline, reroot: bool) -> [Polyline; 3] {
+fn cut_loop(g: &CurveGraph, line: &Polyline, reroot: bool) -> [Polyline; 3] {
     let m = line.edges.len();
     let lowest = |&i: &usize, &j: &usize| {
         let (p, q) = (g.point(line.vertices[i]), g.point(line.vertices[j]));
