@@ -186,6 +186,11 @@ pub(crate) struct Setup<'a> {
     /// [`OptimOptions::keep_shape`] if that is lower, but never below the start's worst),
     /// whatever the metric: sizes are never evened out by spoiling shapes.
     pub shape_floors: &'a [f64],
+    /// ... and quad `q` not below scaled Jacobian `jacobian_floors[q]`: its start value where
+    /// its shape floor is its own start shape (a poor quad), `-∞` elsewhere (a shape of at least
+    /// [`OptimOptions::keep_shape`] keeps the scaled Jacobian above it: at every corner
+    /// `2α / (|a|² + |b|²) ≤ α / (|a| |b|)`). So the worst scaled Jacobian never falls.
+    pub jacobian_floors: &'a [f64],
     pub max_sweeps: usize,
     pub tolerance: f64,
     pub local_iterations: u64,
@@ -231,7 +236,12 @@ impl Setup<'_> {
             return None;
         }
         let (s, shape) = self.quality(p);
-        (s >= self.floor && shape >= self.shape_floors[quad]).then_some((s, shape))
+        let jacobian = self.jacobian_floors[quad];
+        (s >= self.floor
+            && shape >= self.shape_floors[quad]
+            && (jacobian == f64::NEG_INFINITY
+                || imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y])) >= jacobian))
+            .then_some((s, shape))
     }
 
     /// The energy term of quad `p` and its gradient with respect to each corner (`None` where
@@ -309,15 +319,22 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     }
     let before = quality(&mesh.vertices, &mesh.quads);
     let quads = mesh.quads.clone();
-    let shape_floors: Vec<f64> = quads
+    let (shape_floors, jacobian_floors): (Vec<f64>, Vec<f64>) = quads
         .par_iter()
         .map(|q| {
             let p = q.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
-            imesh_quality::quad::shape(&p)
-                .min(options.keep_shape)
-                .max(before.shape.min)
+            let shape = imesh_quality::quad::shape(&p);
+            let jacobian = if shape < options.keep_shape {
+                imesh_quality::quad::scaled_jacobian(&p)
+            } else {
+                f64::NEG_INFINITY
+            };
+            (
+                shape.min(options.keep_shape).max(before.shape.min),
+                jacobian,
+            )
         })
-        .collect();
+        .unzip();
     let average_area = if quads.is_empty() {
         0.0
     } else {
@@ -329,6 +346,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         average_area,
         floor: 0.0,
         shape_floors: &shape_floors,
+        jacobian_floors: &jacobian_floors,
         max_sweeps: options.max_sweeps,
         tolerance: options.tolerance,
         local_iterations: options.local_iterations.max(1),
@@ -408,6 +426,7 @@ mod tests {
             average_area: 1.3,
             floor: 0.0,
             shape_floors: &[0.0],
+            jacobian_floors: &[f64::NEG_INFINITY],
             max_sweeps: 1,
             tolerance: 0.0,
             local_iterations: 1,

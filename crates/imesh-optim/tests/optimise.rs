@@ -136,6 +136,12 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
             report.before.shape.min,
             report.after.shape.min
         );
+        assert!(
+            report.after.scaled_jacobian.min >= report.before.scaled_jacobian.min,
+            "{method:?}: worst scaled Jacobian fell {} → {}",
+            report.before.scaled_jacobian.min,
+            report.after.scaled_jacobian.min
+        );
     }
     (r, report)
 }
