@@ -151,7 +151,7 @@ fn simplify_lines<'a>(
     mut state: State<'a>,
     tolerance: f64,
 ) -> (Vec<Vec<usize>>, State<'a>) {
-    let points = state.g.points();
+    let points = state.g().points();
     let extent: Vec<[f64; 2]> = lines
         .par_iter()
         .map(|line| {
@@ -226,7 +226,6 @@ impl<'g> Index<'g> {
 #[derive(Clone)]
 struct State<'a> {
     index: &'a Index<'a>,
-    g: &'a CurveGraph,
     chords: Vec<[u32; 2]>,
     chord_cells: CellChains,
     /// One stamp per edge and per vertex, so that a query reads one word per candidate:
@@ -246,6 +245,11 @@ struct State<'a> {
 }
 
 impl<'a> State<'a> {
+    /// The input graph.
+    fn g(&self) -> &'a CurveGraph {
+        self.index.g
+    }
+
     fn new(index: &'a Index<'a>) -> Self {
         let g = index.g;
         let vertex_mark = (0..g.points().len() as u32)
@@ -253,7 +257,6 @@ impl<'a> State<'a> {
             .collect();
         Self {
             index,
-            g,
             chords: Vec::new(),
             chord_cells: CellChains::new(index.grid.len()),
             edge_mark: vec![0; g.edges().len()],
@@ -289,17 +292,18 @@ impl<'a> State<'a> {
                 }
                 continue;
             }
-            let (a, b) = (self.g.point(v[i]), self.g.point(v[j]));
+            let (a, b) = (self.g().point(v[i]), self.g().point(v[j]));
             let (mut far, mut deviation2) = (i + 1, -1.0);
             for (k, &x) in v.iter().enumerate().take(j).skip(i + 1) {
-                let d2 = segment_distance_squared(a, b, self.g.point(x));
+                let d2 = segment_distance_squared(a, b, self.g().point(x));
                 if d2 > deviation2 {
                     (far, deviation2) = (k, d2);
                 }
             }
             let deviation = deviation2.sqrt();
             if deviation <= tolerance {
-                if straight(self.g.points(), &v[i..=j]) || self.chord_is_safe(line, i, j, deviation)
+                if straight(self.g().points(), &v[i..=j])
+                    || self.chord_is_safe(line, i, j, deviation)
                 {
                     piece[i] = self.replace(line, i, j);
                     self.max_deviation = self.max_deviation.max(deviation);
@@ -350,14 +354,14 @@ impl<'a> State<'a> {
             }
         }
         let chord = [chain[0], chain[chain.len() - 1]];
-        let points = self.g.points();
+        let points = self.g().points();
         let (a, b) = (points[chord[0] as usize], points[chord[1] as usize]);
 
         // 1. The chord meets no other current edge (the bounding boxes must overlap first).
         let (lo, hi) = bounding_box([a, b].into_iter());
         let mut safe = true;
         let (index, chords, chord_cells) = (self.index, &self.chords, &self.chord_cells);
-        let (input, m) = (self.g.edges(), self.g.edges().len());
+        let (input, m) = (self.g().edges(), self.g().edges().len());
         let edge_mark = &mut self.edge_mark;
         index.grid.cells_near_segment(a, b, 0.0, |c| {
             if !safe {
@@ -459,7 +463,7 @@ impl<'a> State<'a> {
             ..
         } = scratch;
         let v = &line.vertices;
-        let points = self.g.points();
+        let points = self.g().points();
         let mut out = vec![kept[0]];
         let mut a = 0;
         while a + 1 < kept.len() {
@@ -524,7 +528,7 @@ impl<'a> State<'a> {
     /// Takes in what `other`, a copy of this state from before any simplification, did: the
     /// edges and vertices it removed and the chords it added and kept.
     fn absorb(&mut self, other: &State<'_>) {
-        let m = self.g.edges().len();
+        let m = self.g().edges().len();
         let marks = self.edge_mark[..m].iter_mut().zip(&other.edge_mark[..m]);
         for (mark, &there) in marks.chain(self.vertex_mark.iter_mut().zip(&other.vertex_mark)) {
             if there == REMOVED {
@@ -558,7 +562,7 @@ impl<'a> State<'a> {
         let id = self.edge_mark.len() as u32;
         self.chords.push(chord);
         self.edge_mark.push(0);
-        let (a, b) = (self.g.point(chord[0]), self.g.point(chord[1]));
+        let (a, b) = (self.g().point(chord[0]), self.g().point(chord[1]));
         let cells = &mut self.chord_cells;
         self.index
             .grid

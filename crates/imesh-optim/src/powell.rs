@@ -6,6 +6,8 @@
 //! Costs may be `+∞` (an infeasible point): line searches treat such points as worse than any
 //! finite one, so the iterates stay feasible when the start is.
 
+use std::convert::Infallible;
+
 use argmin::core::{
     CostFunction, Error, IterState, Problem, Solver, State, TerminationReason, TerminationStatus,
     KV,
@@ -112,16 +114,16 @@ impl Powell {
 
     /// Minimises along `d` from `x` (cost `fx`): returns the best step and its cost (`(0, fx)`
     /// when no step along `±d` lowers the cost).
-    fn line_minimum(
+    fn line_minimum<E>(
         &self,
-        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, Error>,
+        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, E>,
         x: &[f64],
         d: &Direction,
         fx: f64,
-    ) -> Result<(f64, f64), Error> {
+    ) -> Result<(f64, f64), E> {
         let mut budget = self.line_evaluations;
         let mut y = Vec::with_capacity(x.len());
-        let mut f = |alpha: f64, budget: &mut usize| -> Result<f64, Error> {
+        let mut f = |alpha: f64, budget: &mut usize| -> Result<f64, E> {
             *budget = budget.saturating_sub(1);
             d.step_into(x, alpha, &mut y);
             let c = cost(&y)?;
@@ -232,12 +234,12 @@ impl Powell {
 
     /// One iteration from `x0` (cost `f0`): a line search along each direction, then possibly
     /// one along the net displacement, which may replace the direction of largest decrease.
-    fn iterate(
+    fn iterate<E>(
         &mut self,
-        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, Error>,
+        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, E>,
         x0: Vec<f64>,
         f0: f64,
-    ) -> Result<(Vec<f64>, f64), Error> {
+    ) -> Result<(Vec<f64>, f64), E> {
         let (mut x, mut fx) = (x0.clone(), f0);
         let (mut biggest, mut biggest_at) = (0.0, 0);
         for (i, d) in self.directions.iter().enumerate() {
@@ -298,20 +300,16 @@ impl Powell {
         x0: Vec<f64>,
         max_iters: u64,
     ) -> (Vec<f64>, f64) {
-        let mut cost = |x: &Vec<f64>| -> Result<f64, Error> { Ok(cost(x)) };
-        let (mut x, mut fx) = (x0, f64::INFINITY);
-        if let Ok(f) = cost(&x) {
-            fx = f;
-        }
+        let f0 = cost(&x0);
+        let mut cost = |y: &Vec<f64>| -> Result<f64, Infallible> { Ok(cost(y)) };
+        let (mut x, mut fx) = (x0, f0);
         self.directions = (0..x.len()).map(Direction::Axis).collect();
         let mut previous = f64::INFINITY;
         for iter in 0..max_iters {
             if iter > 0 && self.converged(previous, fx) {
                 break;
             }
-            let Ok((next, f)) = self.iterate(&mut cost, x.clone(), fx) else {
-                break;
-            };
+            let Ok((next, f)) = self.iterate(&mut cost, x.clone(), fx);
             (x, previous, fx) = (next, fx, f);
         }
         (x, fx)
