@@ -217,59 +217,6 @@ impl<T: Copy + Default> CellLists<T> {
     }
 }
 
-/// Items per cell added one by one: singly linked lists in flat arrays, so that appending never
-/// allocates per cell.
-#[derive(Clone, Debug)]
-pub(crate) struct CellChains {
-    head: Vec<u32>,
-    next: Vec<u32>,
-    added: Vec<u32>,
-    /// The cell of each entry of `added`.
-    cell: Vec<u32>,
-}
-
-const END: u32 = u32::MAX;
-
-impl CellChains {
-    /// Empty lists for `cells` cells.
-    pub(crate) fn new(cells: usize) -> Self {
-        Self {
-            head: vec![END; cells],
-            next: Vec::new(),
-            added: Vec::new(),
-            cell: Vec::new(),
-        }
-    }
-
-    /// Adds `item` to the list of `cell`.
-    pub(crate) fn push(&mut self, cell: usize, item: u32) {
-        self.next.push(self.head[cell]);
-        self.added.push(item);
-        self.cell.push(cell as u32);
-        self.head[cell] = (self.added.len() - 1) as u32;
-    }
-
-    /// Every `(cell, item)` pair, in the order they were added.
-    pub(crate) fn entries(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
-        self.cell
-            .iter()
-            .map(|&c| c as usize)
-            .zip(self.added.iter().copied())
-    }
-
-    /// The items of `cell`, the latest first.
-    pub(crate) fn iter(&self, cell: usize) -> impl Iterator<Item = u32> + '_ {
-        let mut at = self.head[cell];
-        std::iter::from_fn(move || {
-            (at != END).then(|| {
-                let x = self.added[at as usize];
-                at = self.next[at as usize];
-                x
-            })
-        })
-    }
-}
-
 /// Registers each edge of `g` in the cells it meets.
 pub(crate) fn edge_cells(g: &CurveGraph, grid: &Grid) -> CellLists {
     let segments = g.edges().iter().map(|e| e.ends.map(|v| g.point(v)));

@@ -5,16 +5,22 @@
 //! topology, in which case the farthest vertex is kept and both halves are tried in turn. The
 //! chord `s` replacing the chain `C` is safe when
 //!
-//! - `s` meets no other edge of the current graph (other than at its two ends), so the graph
-//!   stays planar; and
 //! - the region between `C` and `s` (the points around which the closed curve `C + s` winds, and
-//!   the curve itself) holds no vertex of the current graph other than those of `C`.
+//!   the curve itself) holds no vertex of the current graph other than those of `C`; and
+//! - no other edge of the current graph joins the two ends of `s`.
 //!
-//! With these, every edge that could enter the region would have to cross `s` or `C` or end
-//! inside it, so no curve is jumped over and no face is emptied; a face bounded by `C` and one
-//! other edge joining its ends would need `s` to overlap that edge, which the first test refuses.
-//! Polylines are simplified one after the other against the current state of all others, and a
-//! grid of the current edges and vertices keeps each test local.
+//! These keep the graph planar without testing `s` against the edges. An edge `e` crossing `s`
+//! at a point `X` (not at an end of `s`: edges meet only at their ends) changes the winding
+//! number by one there, so on one side of `X` it runs into the region; it cannot cross `s`
+//! again (two segments meet once unless collinear) nor `C` (the graph is planar), so it ends in
+//! the region or on `C` — the first test refuses the one, and the other makes `e` an edge of `C`
+//! (the inner vertices of `C` have no other edges), which `s` replaces. An edge overlapping `s`
+//! along its line has an end on `s`, or shares both ends with it, which the second test refuses.
+//! So no curve is jumped over and no face is emptied. Polylines are simplified one after the
+//! other against the current state of all others, and a grid of the vertices keeps each test
+//! local.
+
+use std::collections::HashSet;
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -22,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::distance::segment_distance_squared;
 use crate::graph::{CurveGraph, GraphEdge};
-use crate::grid::{conflict, edge_cells, grid_for, within, CellChains, CellLists, Grid};
+use crate::grid::{grid_for, within, CellLists, Grid};
 use crate::polyline::{polylines, Polyline};
 use crate::CurveError;
 
@@ -194,12 +200,11 @@ fn simplify_lines<'a>(
     (kept, state)
 }
 
-/// The input graph indexed for the topology tests: its edges and its live vertices by grid
-/// cell. It never changes, so every [`State`] shares it.
+/// The input graph indexed for the topology test: its live vertices by grid cell. It never
+/// changes, so every [`State`] shares it.
 struct Index<'g> {
     g: &'g CurveGraph,
     grid: Grid,
-    edge_cells: CellLists,
     /// The initially live vertices of each cell, with their points alongside so that a query's
     /// box test reads the cell's memory only.
     vertex_cells: CellLists<(u32, Point)>,
@@ -208,33 +213,26 @@ struct Index<'g> {
 impl<'g> Index<'g> {
     fn new(g: &'g CurveGraph) -> Self {
         let grid = grid_for(g);
-        // The edge lists and the vertex lists are independent: build them side by side.
-        let (edge_cells, vertex_cells) =
-            rayon::join(|| edge_cells(g, &grid), || vertex_cells(g, &grid));
+        let vertex_cells = vertex_cells(g, &grid);
         Self {
             g,
             grid,
-            edge_cells,
             vertex_cells,
         }
     }
 }
 
-/// The current graph during simplification: the input's edges and the chords that replaced
-/// some of them (edge `m + k` is chord `k`, for `m` input edges), which of them are live, and
-/// which vertices are.
+/// The current graph during simplification, as far as the topology test needs it: which
+/// vertices are live, and which pairs of polyline ends a chord now joins directly.
 #[derive(Clone)]
 struct State<'a> {
     index: &'a Index<'a>,
-    chords: Vec<[u32; 2]>,
-    chord_cells: CellChains,
-    /// One stamp per edge and per vertex, so that a query reads one word per candidate:
-    /// [`REMOVED`] once it has left the graph; the current query's number while it is in the
-    /// curve under test (and, for an edge, once the query has seen it: an edge crosses several
-    /// cells, a vertex lies in one).
-    edge_mark: Vec<u32>,
+    /// One stamp per vertex, so that a query reads one word per candidate: [`REMOVED`] once it
+    /// has left the graph; the current query's number while it is in the curve under test.
     vertex_mark: Vec<u32>,
     query: u32,
+    /// The end pairs (lower id first) of the polylines that a chord has replaced whole.
+    joined: HashSet<[u32; 2]>,
     /// Buffers reused from one polyline to the next (most polylines are a few edges long, so
     /// allocating these per polyline would cost more than the work on them).
     scratch: Scratch,
@@ -257,11 +255,9 @@ impl<'a> State<'a> {
             .collect();
         Self {
             index,
-            chords: Vec::new(),
-            chord_cells: CellChains::new(index.grid.len()),
-            edge_mark: vec![0; g.edges().len()],
             vertex_mark,
             query: 0,
+            joined: HashSet::new(),
             scratch: Scratch::default(),
             refused: 0,
             merged: 0,
@@ -273,23 +269,15 @@ impl<'a> State<'a> {
     fn simplify_line(&mut self, line: &Polyline, tolerance: f64) -> Vec<usize> {
         let v = &line.vertices;
         let mut scratch = std::mem::take(&mut self.scratch);
-        let Scratch {
-            keep, piece, stack, ..
-        } = &mut scratch;
+        let Scratch { keep, stack, .. } = &mut scratch;
         keep.clear();
         keep.resize(v.len(), false);
         keep[0] = true;
         keep[v.len() - 1] = true;
-        // The current edge of the piece starting at each kept vertex.
-        piece.clear();
-        piece.resize(v.len(), u32::MAX);
         stack.clear();
         stack.push((0, v.len() - 1));
         while let Some((i, j)) = stack.pop() {
             if j <= i + 1 {
-                if j == i + 1 {
-                    piece[i] = line.edges[i];
-                }
                 continue;
             }
             let (a, b) = (self.g().point(v[i]), self.g().point(v[j]));
@@ -302,10 +290,11 @@ impl<'a> State<'a> {
             }
             let deviation = deviation2.sqrt();
             if deviation <= tolerance {
-                if straight(self.g().points(), &v[i..=j])
-                    || self.chord_is_safe(line, i, j, deviation)
+                let chain = &v[i..=j];
+                if straight(self.g().points(), chain)
+                    || self.shortcut_is_safe(chain, chain, deviation)
                 {
-                    piece[i] = self.replace(line, i, j);
+                    self.replace(chain, v.len() == chain.len());
                     self.max_deviation = self.max_deviation.max(deviation);
                     continue;
                 }
@@ -325,79 +314,35 @@ impl<'a> State<'a> {
         kept
     }
 
-    /// The two tests of the module documentation for the chord `v[i] v[j]` replacing the chain
-    /// `v[i..=j]`, whose vertices are within `deviation` of the chord.
-    fn chord_is_safe(&mut self, line: &Polyline, i: usize, j: usize, deviation: f64) -> bool {
-        let chain = &line.vertices[i..=j];
-        self.shortcut_is_safe(chain, &line.edges[i..j], chain, deviation)
-    }
-
-    /// The tests of [`State::chord_is_safe`] for a chord replacing the current curve `chain`
-    /// (vertex ids, first and last the chord's ends), whose current edges are `edges`; the
-    /// vertices in `own` are the curve's (some no longer live), and every vertex of `chain` is
-    /// within `deviation` of the chord.
-    fn shortcut_is_safe(
-        &mut self,
-        chain: &[u32],
-        edges: &[u32],
-        own: &[u32],
-        deviation: f64,
-    ) -> bool {
+    /// The topology test of the module documentation for a chord replacing the current curve
+    /// `chain` (vertex ids, first and last the chord's ends, at least three); the vertices in
+    /// `own` are the curve's (some no longer live), and every vertex of `chain` is within
+    /// `deviation` of the chord.
+    fn shortcut_is_safe(&mut self, chain: &[u32], own: &[u32], deviation: f64) -> bool {
+        let points = self.g().points();
+        let chord = [chain[0], chain[chain.len() - 1]];
+        // Another edge joining the chord's ends: only an input edge or a chord replacing a
+        // whole polyline can (an inner vertex of a polyline has no edges but the polyline's).
+        let other = |e: &u32| {
+            let [u, w] = self.g().edges()[*e as usize].ends;
+            u ^ w ^ chord[0] == chord[1]
+        };
+        if self.g().incident(chord[0]).iter().any(other) || self.joined.contains(&pair(chord)) {
+            return false;
+        }
         self.query += 1;
         let q = self.query;
-        for &e in edges {
-            self.edge_mark[e as usize] = q;
-        }
         for &x in own {
             if self.vertex_mark[x as usize] != REMOVED {
                 self.vertex_mark[x as usize] = q;
             }
         }
-        let chord = [chain[0], chain[chain.len() - 1]];
-        let points = self.g().points();
         let (a, b) = (points[chord[0] as usize], points[chord[1] as usize]);
-
-        // 1. The chord meets no other current edge (the bounding boxes must overlap first).
-        let (lo, hi) = bounding_box([a, b].into_iter());
-        let mut safe = true;
-        let (index, chords, chord_cells) = (self.index, &self.chords, &self.chord_cells);
-        let (input, m) = (self.g().edges(), self.g().edges().len());
-        let edge_mark = &mut self.edge_mark;
-        index.grid.cells_near_segment(a, b, 0.0, |c| {
-            if !safe {
-                return;
-            }
-            let edges = index.edge_cells.get(c).iter().copied();
-            for e in edges.chain(chord_cells.iter(c)) {
-                let e = e as usize;
-                if edge_mark[e] == q || edge_mark[e] == REMOVED {
-                    continue;
-                }
-                edge_mark[e] = q;
-                let [u, w] = if e < m { input[e].ends } else { chords[e - m] };
-                let (pu, pw) = (points[u as usize], points[w as usize]);
-                if pu.x.max(pw.x) < lo.x
-                    || pu.x.min(pw.x) > hi.x
-                    || pu.y.max(pw.y) < lo.y
-                    || pu.y.min(pw.y) > hi.y
-                {
-                    continue;
-                }
-                if conflict(points, chord, [u, w]) {
-                    safe = false;
-                    return;
-                }
-            }
-        });
-        if !safe {
-            return false;
-        }
-
-        // 2. No other current vertex in the region between the chain and the chord.
         let (lo, hi) = bounding_box(chain.iter().map(|&x| points[x as usize]));
-        let vertex_mark = &self.vertex_mark;
+        let (index, vertex_mark) = (self.index, &self.vertex_mark);
         let pad = deviation * (1.0 + 1e-12) + 1e-12;
         let reach2 = (deviation * (1.0 + 1e-9) + 1e-9).powi(2);
+        let mut safe = true;
         index.grid.cells_near_segment(a, b, pad, |c| {
             if !safe {
                 return;
@@ -425,19 +370,14 @@ impl<'a> State<'a> {
         safe
     }
 
-    /// Replaces the chain `v[i..=j]` by its chord in the current graph.
-    fn replace(&mut self, line: &Polyline, i: usize, j: usize) -> u32 {
-        self.replace_edges(&line.edges[i..j], &line.vertices[i + 1..j]);
-        self.add_chord([line.vertices[i], line.vertices[j]])
-    }
-
-    /// Removes `edges` and `vertices` from the current graph.
-    fn replace_edges(&mut self, edges: &[u32], vertices: &[u32]) {
-        for &e in edges {
-            self.edge_mark[e as usize] = REMOVED;
-        }
-        for &x in vertices {
+    /// Replaces the current curve `chain` by its chord, which joins the ends of its polyline
+    /// when `whole`.
+    fn replace(&mut self, chain: &[u32], whole: bool) {
+        for &x in &chain[1..chain.len() - 1] {
             self.vertex_mark[x as usize] = REMOVED;
+        }
+        if whole {
+            self.joined.insert(pair([chain[0], chain[chain.len() - 1]]));
         }
     }
 
@@ -447,7 +387,7 @@ impl<'a> State<'a> {
     /// tolerance of one chord (a zig-zag's sub-chords all end at a tip: none is within the
     /// tolerance until the whole run is). From each kept vertex, the longest run of up to
     /// [`MERGE_SPAN`] following pieces whose original vertices are all within the tolerance of
-    /// one chord, and whose chord passes the topology tests against the current graph, becomes
+    /// one chord, and whose chord passes the topology test against the current graph, becomes
     /// that chord. Returns the kept indices left.
     fn merge_pieces(
         &mut self,
@@ -456,12 +396,7 @@ impl<'a> State<'a> {
         scratch: &mut Scratch,
         tolerance: f64,
     ) -> Vec<usize> {
-        let Scratch {
-            piece,
-            curve,
-            edges,
-            ..
-        } = scratch;
+        let curve = &mut scratch.curve;
         let v = &line.vertices;
         let points = self.g().points();
         let mut out = vec![kept[0]];
@@ -481,20 +416,15 @@ impl<'a> State<'a> {
                 }
                 curve.clear();
                 curve.extend(kept[a..=b].iter().map(|&k| v[k]));
-                edges.clear();
-                edges.extend(kept[a..b].iter().map(|&k| piece[k]));
-                if self.shortcut_is_safe(curve, edges, &v[i..=j], deviation) {
+                if self.shortcut_is_safe(curve, &v[i..=j], deviation) {
                     best = (b, deviation);
                 }
             }
             let (b, deviation) = best;
             if b > a + 1 {
-                edges.clear();
-                edges.extend(kept[a..b].iter().map(|&k| piece[k]));
                 curve.clear();
-                curve.extend(kept[a + 1..b].iter().map(|&k| v[k]));
-                self.replace_edges(edges, curve);
-                self.add_chord([v[kept[a]], v[kept[b]]]);
+                curve.extend(kept[a..=b].iter().map(|&k| v[k]));
+                self.replace(curve, a == 0 && b == kept.len() - 1);
                 self.max_deviation = self.max_deviation.max(deviation);
                 self.merged += b - a - 1;
             }
@@ -526,48 +456,17 @@ impl<'a> State<'a> {
     }
 
     /// Takes in what `other`, a copy of this state from before any simplification, did: the
-    /// edges and vertices it removed and the chords it added and kept.
+    /// vertices it removed and the polylines it replaced whole.
     fn absorb(&mut self, other: &State<'_>) {
-        let m = self.g().edges().len();
-        let marks = self.edge_mark[..m].iter_mut().zip(&other.edge_mark[..m]);
-        for (mark, &there) in marks.chain(self.vertex_mark.iter_mut().zip(&other.vertex_mark)) {
+        for (mark, &there) in self.vertex_mark.iter_mut().zip(&other.vertex_mark) {
             if there == REMOVED {
                 *mark = REMOVED;
             }
         }
-        // Only the chords still live there (the second pass replaces some of the first's), in
-        // the cells the other state found for them. Their ids there are `m + k` for chord `k`;
-        // here they follow this state's own.
-        let mut id = vec![REMOVED; other.chords.len()];
-        for (k, (&chord, &mark)) in other.chords.iter().zip(&other.edge_mark[m..]).enumerate() {
-            if mark != REMOVED {
-                id[k] = self.edge_mark.len() as u32;
-                self.chords.push(chord);
-                self.edge_mark.push(0);
-            }
-        }
-        for (cell, e) in other.chord_cells.entries() {
-            let e = id[e as usize - m];
-            if e != REMOVED {
-                self.chord_cells.push(cell, e);
-            }
-        }
+        self.joined.extend(other.joined.iter().copied());
         self.merged += other.merged;
         self.refused += other.refused;
         self.max_deviation = self.max_deviation.max(other.max_deviation);
-    }
-
-    /// Adds the chord `chord` to the current graph.
-    fn add_chord(&mut self, chord: [u32; 2]) -> u32 {
-        let id = self.edge_mark.len() as u32;
-        self.chords.push(chord);
-        self.edge_mark.push(0);
-        let (a, b) = (self.g().point(chord[0]), self.g().point(chord[1]));
-        let cells = &mut self.chord_cells;
-        self.index
-            .grid
-            .cells_near_segment(a, b, 0.0, |c| cells.push(c, id));
-        id
     }
 }
 
@@ -576,16 +475,18 @@ impl<'a> State<'a> {
 struct Scratch {
     /// Per vertex of the polyline: kept by Douglas–Peucker.
     keep: Vec<bool>,
-    /// Per kept vertex of the polyline: the current edge of the piece that starts there.
-    piece: Vec<u32>,
     /// Douglas–Peucker's pending index ranges.
     stack: Vec<(usize, usize)>,
-    /// A curve under test (vertex ids) and its current edges.
+    /// A curve under test (vertex ids).
     curve: Vec<u32>,
-    edges: Vec<u32>,
 }
 
-/// The stamp of an edge or a vertex that has left the current graph (see `State::edge_mark`).
+/// An edge's ends, lower id first.
+fn pair([u, w]: [u32; 2]) -> [u32; 2] {
+    [u.min(w), u.max(w)]
+}
+
+/// The stamp of a vertex that has left the current graph (see `State::vertex_mark`).
 const REMOVED: u32 = u32::MAX;
 
 /// True when every vertex of the chain lies exactly on the segment between its ends: the chord
