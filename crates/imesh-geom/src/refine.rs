@@ -11,7 +11,6 @@
 //! and an insertion cap bounds the work on any input. Triangles labelled [`EXTERIOR`] are never
 //! refined.
 
-use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use crate::predicates::orient2d;
@@ -62,7 +61,7 @@ pub struct RefineReport {
 /// A queued bad triangle: its vertices and its slot. Slots are reused as insertions replace
 /// triangles, so an entry whose slot no longer holds these vertices (in this order) is stale; a
 /// triangle that reappears elsewhere was queued again when it was made.
-#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy)]
 struct Bad {
     vertices: [u32; 3],
     slot: u32,
@@ -71,23 +70,53 @@ struct Bad {
 /// Bad triangles by the squared length of their shortest edge, shortest first, as Triangle
 /// orders them: splitting the smallest triangles first lets their new points fix the larger bad
 /// triangles around them too, which inserts far fewer points than splitting the skinniest first
-/// (about 0.6× at 33°). Ties, frequent on pixel lattices, go to the lowest vertex ids (the
-/// oldest vertices): 2–3% fewer points than first in, first out.
+/// (about 0.6× at 33°). Ties (keys equal in single precision, frequent on pixel lattices) go to
+/// the triangle with the oldest vertex: 2–3% fewer points than first in, first out.
 #[derive(Default)]
 struct BadQueue {
-    /// A max-heap on reversed keys. A non-negative float orders as its bit pattern.
-    heap: BinaryHeap<(Reverse<u64>, Reverse<Bad>)>,
+    heap: BinaryHeap<Queued>,
+}
+
+/// A heap entry: the order is `rank`'s alone, so that a pop compares one word per step.
+struct Queued {
+    rank: u64,
+    bad: Bad,
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, o: &Self) -> bool {
+        self.rank == o.rank
+    }
+}
+impl Eq for Queued {}
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Queued {
+    /// The max-heap pops the lowest rank first.
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        o.rank.cmp(&self.rank)
+    }
 }
 
 impl BadQueue {
     fn push(&mut self, key: f64, bad: Bad) {
-        // A NaN key (not finite coordinates) sorts last.
-        let key = if key >= 0.0 { key.to_bits() } else { u64::MAX };
-        self.heap.push((Reverse(key), Reverse(bad)));
+        // The key in single precision (a non-negative float orders as its bit pattern; NaN, from
+        // coordinates too large, goes last), then the lowest vertex id.
+        let key = if key >= 0.0 {
+            (key as f32).to_bits()
+        } else {
+            u32::MAX
+        };
+        let oldest = bad.vertices[0].min(bad.vertices[1]).min(bad.vertices[2]);
+        let rank = (u64::from(key) << 32) | u64::from(oldest);
+        self.heap.push(Queued { rank, bad });
     }
 
     fn pop(&mut self) -> Option<Bad> {
-        self.heap.pop().map(|(_, Reverse(bad))| bad)
+        self.heap.pop().map(|q| q.bad)
     }
 }
 
@@ -148,8 +177,6 @@ enum ShellSplit {
 
 /// What to do about one bad triangle.
 enum Plan {
-    /// Insert its circumcentre, which lies in this triangle.
-    Insert(u32),
     /// Split these segment pieces first (the triangle is queued again).
     Split(Vec<[u32; 2]>),
     /// Leave the triangle as it is.
@@ -373,20 +400,36 @@ impl Triangulation {
                 Target::Lost => Plan::GiveUp,
                 Target::Blocked(h) => Plan::Split(vec![self.edge_ends(h)]),
                 Target::Found { triangle } => {
-                    let threatened = self.segments_encroached_by(triangle, c, queues.lens);
-                    if !threatened.is_empty() {
-                        Plan::Split(threatened)
-                    } else {
+                    let lens = queues.lens;
+                    let objection = self.insert_unless(c, triangle, |tri, touched| {
+                        // Segments of the cavity that the point would encroach go first.
+                        let threatened: Vec<[u32; 2]> = touched
+                            .iter()
+                            .map(|&e| tri.edge_ends(e))
+                            .filter(|&[u, w]| {
+                                let [pu, pw] = [u, w].map(|x| tri.points[x as usize]);
+                                in_diametral_lens(pu, pw, c, lens)
+                            })
+                            .collect();
+                        if !threatened.is_empty() {
+                            return Some(Plan::Split(threatened));
+                        }
                         let candidate = Candidate {
                             bad: TriangleId(t),
                             point: c,
                             containing: TriangleId(triangle),
                         };
-                        if self.refinable(triangle) && policy(self, &candidate) {
-                            Plan::Insert(triangle)
-                        } else {
-                            Plan::GiveUp
+                        (!(tri.refinable(triangle) && policy(tri, &candidate)))
+                            .then_some(Plan::GiveUp)
+                    })?;
+                    match objection {
+                        Err(plan) => plan,
+                        Ok(v) if v.0 as usize == self.points.len() - 1 => {
+                            self.after_insertion(&mut queues, &mut report);
+                            continue;
                         }
+                        // The point is a vertex already.
+                        Ok(_) => Plan::GiveUp,
                     }
                 }
             };
@@ -400,15 +443,6 @@ impl Triangulation {
                 Plan::Split(pieces) => {
                     forced.extend(pieces);
                     queues.bad.push(shortest, bad);
-                }
-                Plan::Insert(triangle) => {
-                    let before = self.points.len();
-                    self.insert_near(c, TriangleId(triangle))?;
-                    if self.points.len() > before {
-                        self.after_insertion(&mut queues, &mut report);
-                    } else {
-                        report.bad_left += 1;
-                    }
                 }
             }
         }
@@ -563,36 +597,6 @@ impl Triangulation {
                 .map(|v| self.points[v as usize]);
             in_diametral_lens(u, w, a, lens).then_some(apex)
         })
-    }
-
-    /// Constrained edges of the cavity of `c` (grown from triangle `t`) whose diametral circle
-    /// holds `c`.
-    fn segments_encroached_by(&self, t: u32, c: Point, lens: f64) -> Vec<[u32; 2]> {
-        let mut out = Vec::new();
-        let mut stack = vec![t];
-        let mut seen = vec![t];
-        while let Some(t) = stack.pop() {
-            for e in 3 * t..3 * t + 3 {
-                let o = self.twin[e as usize] / 3;
-                if self.segment[e as usize] != NONE {
-                    let [u, w] = [self.origin[e as usize], self.origin[next(e) as usize]];
-                    if in_diametral_lens(self.points[u as usize], self.points[w as usize], c, lens)
-                    {
-                        out.push([u, w]);
-                    }
-                    continue;
-                }
-                if seen.contains(&o) || self.is_ghost_slot(o) {
-                    continue;
-                }
-                let [a, b, d] = self.triangle_points(TriangleId(o));
-                if crate::predicates::incircle(a, b, d, c) > 0.0 {
-                    seen.push(o);
-                    stack.push(o);
-                }
-            }
-        }
-        out
     }
 
     /// True when the constrained edge of `h` is long enough to split in floating point: at least

@@ -43,6 +43,8 @@ pub(crate) struct Scratch {
     boundary: Vec<(u32, u32, u32)>,
     /// Deduplication of the pending (collinear) vertices.
     pending_index: HashMap<(u64, u64), u32>,
+    /// The constrained edges an insertion would touch (see `insert_unless`).
+    touched: Vec<u32>,
 }
 
 /// Result of a visibility walk.
@@ -151,6 +153,49 @@ impl Triangulation {
             self.hint.store(near.0, Ordering::Relaxed);
         }
         self.insert(p)
+    }
+
+    /// Inserts `p`, which lies in the closed real triangle `seed`, unless `veto` objects once it
+    /// has seen where: `veto` gets the constrained edges the insertion would touch (the cavity's
+    /// constrained boundary half-edges, cavity side, and the constrained edge `p` lies on, if
+    /// any) and returns its objection, and then nothing changes. Returns the new vertex, or the
+    /// vertex of `seed` that `p` coincides with.
+    ///
+    /// Refinement asks whether a circumcentre would encroach a segment of its cavity before it
+    /// inserts it: digging the cavity once serves both.
+    pub(crate) fn insert_unless<R>(
+        &mut self,
+        p: Point,
+        seed: u32,
+        veto: impl FnOnce(&Self, &[u32]) -> Option<R>,
+    ) -> Result<Result<VertexId, R>, GeomError> {
+        validate(std::slice::from_ref(&p))?;
+        for e in 3 * seed..3 * seed + 3 {
+            let a = self.origin[e as usize];
+            if self.points[a as usize] == p {
+                return Ok(Ok(VertexId(a)));
+            }
+        }
+        let split = self.constrained_edge_through(seed, p);
+        self.dig_cavity(seed, p, split);
+        let mut touched = std::mem::take(&mut self.scratch.touched);
+        touched.clear();
+        if !self.segment.is_empty() {
+            let boundary = self.scratch.boundary.iter().map(|b| b.2);
+            touched.extend(boundary.filter(|&e| self.segment[e as usize] != NONE));
+        }
+        touched.extend(split);
+        let objection = veto(self, &touched);
+        self.scratch.touched = touched;
+        if let Some(objection) = objection {
+            return Ok(Err(objection));
+        }
+        let v = self.points.len() as u32;
+        self.points.push(p);
+        self.out_edge.push(NONE);
+        self.created.clear();
+        self.fill_cavity(v, split);
+        Ok(Ok(VertexId(v)))
     }
 
     /// The real triangles created by the last [`insert`](Self::insert) (they replace the triangles
