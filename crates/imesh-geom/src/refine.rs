@@ -11,7 +11,7 @@
 //! and an insertion cap bounds the work on any input. Triangles labelled [`EXTERIOR`] are never
 //! refined.
 
-use std::collections::BinaryHeap;
+use dary_heap::QuaternaryHeap;
 
 use crate::predicates::orient2d;
 use crate::triangulation::{next, prev, GHOST, NONE};
@@ -72,9 +72,12 @@ struct Bad {
 /// triangles around them too, which inserts far fewer points than splitting the skinniest first
 /// (about 0.6× at 33°). Ties (keys equal in single precision, frequent on pixel lattices) go to
 /// the triangle with the oldest vertex: 2–3% fewer points than first in, first out.
+///
+/// A four-ary heap: half the levels of a binary one, whose children share a cache line or two
+/// (pops were a sixth of refinement's time with `std`'s binary heap; 4% less time overall).
 #[derive(Default)]
 struct BadQueue {
-    heap: BinaryHeap<Queued>,
+    heap: QuaternaryHeap<Queued>,
 }
 
 /// A heap entry: the order is `rank`'s alone, so that a pop compares one word per step.
