@@ -8,6 +8,10 @@ fn point() -> impl Strategy<Value = Point> {
     (-100.0..100.0f64, -100.0..100.0f64).prop_map(|(x, y)| Point::new(x, y))
 }
 
+fn unit_point() -> impl Strategy<Value = Point> {
+    (0.0..1.0f64, 0.0..1.0f64).prop_map(|(x, y)| Point::new(x, y))
+}
+
 fn cubic() -> impl Strategy<Value = CubicBezier> {
     [point(), point(), point(), point()].prop_map(CubicBezier::new)
 }
@@ -55,7 +59,19 @@ proptest! {
     }
 
     #[test]
+    fn both_halves_of_a_unit_scale_split_reproduce_the_curve_to_1e_12(
+        c in [unit_point(), unit_point(), unit_point(), unit_point()].prop_map(CubicBezier::new),
+        t in 0.01..0.99f64,
+        u in 0.0..=1.0f64,
+    ) {
+        let (left, right) = c.split(t);
+        prop_assert!(close(left.eval(u), c.eval(t * u), 1e-12));
+        prop_assert!(close(right.eval(u), c.eval(t + (1.0 - t) * u), 1e-12));
+    }
+
+    #[test]
     fn both_halves_of_a_split_reproduce_the_curve(c in cubic(), t in 0.01..0.99f64, u in 0.0..=1.0f64) {
+        // 1e-12 of the curves' extent (coordinates up to 100 in size).
         let (left, right) = c.split(t);
         prop_assert!(close(left.eval(u), c.eval(t * u), 1e-12 * 200.0));
         prop_assert!(close(right.eval(u), c.eval(t + (1.0 - t) * u), 1e-12 * 200.0));
