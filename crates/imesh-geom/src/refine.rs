@@ -322,11 +322,11 @@ impl Triangulation {
             n_input,
             ends: Vec::new(),
         };
-        let all: Vec<u32> = (0..self.origin.len() as u32 / 3).collect();
+        let all = 0..self.origin.len() as u32 / 3;
         let lens = (2.0 * min_angle).cos().powi(2);
         let mut queues = Queues {
             bad: BadQueue::default(),
-            encroached: self.encroached_among(&all, lens),
+            encroached: Vec::new(),
             cos2_bound: min_angle.cos().powi(2),
             max_area: options.max_area,
             // Üngör's off-centre distance, as a multiple of the shortest edge: 0.475·cot(θ/2),
@@ -334,7 +334,8 @@ impl Triangulation {
             off_constant: 0.475 / (0.5 * min_angle).tan(),
             lens,
         };
-        self.queue_bad(&all, &mut queues);
+        self.encroached_among(all.clone(), lens, &mut queues.encroached);
+        self.queue_bad(all, &mut queues);
         // Segments that must be split whether or not a vertex encroaches them now: they block a
         // circumcentre, or the circumcentre would encroach them.
         let mut forced: Vec<[u32; 2]> = Vec::new();
@@ -540,8 +541,8 @@ impl Triangulation {
     }
 
     /// Queues the bad triangles among `triangles`.
-    fn queue_bad(&self, triangles: &[u32], queues: &mut Queues) {
-        for &t in triangles {
+    fn queue_bad(&self, triangles: impl IntoIterator<Item = u32>, queues: &mut Queues) {
+        for t in triangles {
             if !self.refinable(t) {
                 continue;
             }
@@ -562,20 +563,23 @@ impl Triangulation {
     /// encroach.
     fn after_insertion(&self, queues: &mut Queues, report: &mut RefineReport) {
         report.inserted += 1;
-        let created: Vec<u32> = self.created.iter().map(|t| t.0).collect();
-        self.queue_bad(&created, queues);
-        queues
-            .encroached
-            .extend(self.encroached_among(&created, queues.lens));
+        let created = || self.created.iter().map(|t| t.0);
+        self.queue_bad(created(), queues);
+        self.encroached_among(created(), queues.lens, &mut queues.encroached);
     }
 
-    /// Constrained edges of these triangles that are encroached by an adjacent apex.
-    fn encroached_among(&self, triangles: &[u32], lens: f64) -> Vec<[u32; 2]> {
-        let mut out = Vec::new();
+    /// Appends to `out` the constrained edges of these triangles that are encroached by an
+    /// adjacent apex.
+    fn encroached_among(
+        &self,
+        triangles: impl IntoIterator<Item = u32>,
+        lens: f64,
+        out: &mut Vec<[u32; 2]>,
+    ) {
         if self.segment.is_empty() {
-            return out;
+            return;
         }
-        for &t in triangles {
+        for t in triangles {
             if self.is_ghost_slot(t) {
                 continue;
             }
@@ -585,7 +589,6 @@ impl Triangulation {
                 }
             }
         }
-        out
     }
 
     /// The apex of a real refinable triangle beside constrained half-edge `e` that lies strictly
