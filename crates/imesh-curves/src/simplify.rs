@@ -325,7 +325,8 @@ impl<'a> State<'a> {
         // whole polyline can (an inner vertex of a polyline has no edges but the polyline's).
         let other = |e: &u32| {
             let [u, w] = self.g().edges()[*e as usize].ends;
-            u ^ w ^ chord[0] == chord[1]
+            let far = if u == chord[0] { w } else { u };
+            far == chord[1]
         };
         if self.g().incident(chord[0]).iter().any(other) || self.joined.contains(&pair(chord)) {
             return false;

@@ -14,7 +14,7 @@
 use dary_heap::QuaternaryHeap;
 
 use crate::predicates::orient2d;
-use crate::triangulation::{next, prev, GHOST, NONE};
+use crate::triangulation::{next, prev, Inserted, GHOST, NONE};
 use crate::{GeomError, Point, TriangleId, Triangulation, VertexId, EXTERIOR};
 
 /// Parameters of [`Triangulation::refine`].
@@ -428,12 +428,12 @@ impl Triangulation {
                     })?;
                     match objection {
                         Err(plan) => plan,
-                        Ok(v) if v.0 as usize == self.points.len() - 1 => {
+                        Ok(Inserted::New) => {
                             self.after_insertion(&mut queues, &mut report);
                             continue;
                         }
                         // The point is a vertex already.
-                        Ok(_) => Plan::GiveUp,
+                        Ok(Inserted::Duplicate(_)) => Plan::GiveUp,
                     }
                 }
             };

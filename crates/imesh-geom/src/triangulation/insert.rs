@@ -55,8 +55,8 @@ enum Walk {
     Outside(u32),
 }
 
-/// Result of inserting a stored vertex.
-enum Inserted {
+/// Result of inserting a point: a new vertex, or the existing vertex it coincides with.
+pub(crate) enum Inserted {
     New,
     Duplicate(u32),
 }
@@ -168,13 +168,10 @@ impl Triangulation {
         p: Point,
         seed: u32,
         veto: impl FnOnce(&Self, &[u32]) -> Option<R>,
-    ) -> Result<Result<VertexId, R>, GeomError> {
+    ) -> Result<Result<Inserted, R>, GeomError> {
         validate(std::slice::from_ref(&p))?;
-        for e in 3 * seed..3 * seed + 3 {
-            let a = self.origin[e as usize];
-            if self.points[a as usize] == p {
-                return Ok(Ok(VertexId(a)));
-            }
+        if let Some(a) = self.vertex_at(seed, p) {
+            return Ok(Ok(Inserted::Duplicate(a)));
         }
         let split = self.constrained_edge_through(seed, p);
         self.dig_cavity(seed, p, split);
@@ -190,12 +187,26 @@ impl Triangulation {
         if let Some(objection) = objection {
             return Ok(Err(objection));
         }
+        self.fill_dug_cavity(p, split);
+        Ok(Ok(Inserted::New))
+    }
+
+    /// Adds `p` as a new vertex and fills the cavity `dig_cavity` left in
+    /// the scratch space with its fan; returns the vertex.
+    fn fill_dug_cavity(&mut self, p: Point, split: Option<u32>) -> u32 {
         let v = self.points.len() as u32;
         self.points.push(p);
         self.out_edge.push(NONE);
         self.created.clear();
         self.fill_cavity(v, split);
-        Ok(Ok(VertexId(v)))
+        v
+    }
+
+    /// The vertex of real triangle `t` at exactly `p`, if any.
+    fn vertex_at(&self, t: u32, p: Point) -> Option<u32> {
+        (3 * t..3 * t + 3)
+            .map(|e| self.origin[e as usize])
+            .find(|&a| self.points[a as usize] == p)
     }
 
     /// The real triangles created by the last [`insert`](Self::insert) (they replace the triangles
@@ -224,11 +235,8 @@ impl Triangulation {
                 Location::OutsideHull(HalfEdgeId(self.twin[self.ghost_real_edge(g) as usize]))
             }
             Walk::Inside(t) => {
-                for e in 3 * t..3 * t + 3 {
-                    let a = self.origin[e as usize];
-                    if self.points[a as usize] == p {
-                        return Location::OnVertex(VertexId(a));
-                    }
+                if let Some(a) = self.vertex_at(t, p) {
+                    return Location::OnVertex(VertexId(a));
                 }
                 for e in 3 * t..3 * t + 3 {
                     let (a, b) = (self.origin[e as usize], self.origin[next(e) as usize]);
@@ -320,11 +328,8 @@ impl Triangulation {
         let seed = match self.walk(p) {
             Walk::Outside(g) => g,
             Walk::Inside(t) => {
-                for e in 3 * t..3 * t + 3 {
-                    let a = self.origin[e as usize];
-                    if self.points[a as usize] == p {
-                        return Inserted::Duplicate(a);
-                    }
+                if let Some(a) = self.vertex_at(t, p) {
+                    return Inserted::Duplicate(a);
                 }
                 t
             }
@@ -369,14 +374,8 @@ impl Triangulation {
                 k *= 2.0;
             }
         }
-        let v = self.points.len() as u32;
-        self.points.push(p);
-        self.out_edge.push(NONE);
-        self.created.clear();
-        let seed = real / 3;
-        self.dig_cavity(seed, p, Some(e));
-        self.fill_cavity(v, Some(e));
-        Ok(VertexId(v))
+        self.dig_cavity(real / 3, p, Some(e));
+        Ok(VertexId(self.fill_dug_cavity(p, Some(e))))
     }
 
     /// When `p` lies on the interior of a constrained edge of real triangle `t`: that half-edge.

@@ -22,6 +22,7 @@ use crate::Point;
 
 pub use check::TriangulationDefect;
 pub use constrain::{SegmentId, EXTERIOR};
+pub(crate) use insert::Inserted;
 pub use insert::Location;
 
 /// The vertex at infinity, third vertex of every ghost triangle.
