@@ -313,7 +313,13 @@ pub fn simplify(data: &[u8]) {
         Err(e) => panic!("c-edge graph: {e}"),
     };
     assert_eq!(g.crossing(), None, "the c-edges cross");
-    let s = match imesh_curves::simplify(&g, &SimplifyOptions { tolerance }) {
+    let s = match imesh_curves::simplify(
+        &g,
+        &SimplifyOptions {
+            tolerance,
+            ..Default::default()
+        },
+    ) {
         Ok(s) => s,
         Err(e) => panic!("simplify: {e}"),
     };
@@ -411,7 +417,8 @@ pub fn pipeline(data: &[u8]) {
         ElementSize::Pixels(2.5),
     ]);
     options.min_region = b.pick(&[0, 3, 12]);
-    options.majority = b.pick(&[0, 0, 1, 2]);
+    options.majority = b.pick(&[Some(0), None, Some(1), Some(2)]);
+    options.min_width = b.pick(&[None, Some(0.0), Some(3.0)]);
     if options.optimizer == OptimizerMethod::Global && grid.width() * grid.height() > 64 {
         options.optimizer = OptimizerMethod::Local;
     }

@@ -200,7 +200,7 @@ fn uniform() -> MeshOptions {
     MeshOptions {
         size: imesh::ElementSize::Pixels(3.0),
         min_region: 50,
-        majority: 2,
+        majority: Some(2),
         ..MeshOptions::default()
     }
 }

@@ -34,7 +34,7 @@ mod threshold;
 
 use image::DynamicImage;
 
-pub use cleanup::{majority_filter, remove_small_regions};
+pub use cleanup::{majority_filter, pixel_regions, remove_small_regions, PixelRegion};
 pub use error::ClassifyError;
 pub use grid::{LabelGrid, Region};
 pub use kmeans::kmeans;

@@ -44,12 +44,18 @@ pub struct SimplifyOptions {
     /// The largest distance, in pixels, from a removed vertex to the simplified edge that
     /// replaces it.
     pub tolerance: f64,
+    /// Pieces shorter than this, in pixels, are joined with a neighbouring piece of their
+    /// polyline (the third pass) when the joined chord stays within the larger of the tolerance
+    /// and half this length of the original vertices and passes the topology test: short
+    /// boundary pieces make small elements along them. 0 (default): no third pass.
+    pub min_length: f64,
 }
 
 impl Default for SimplifyOptions {
     fn default() -> Self {
         Self {
             tolerance: DEFAULT_TOLERANCE,
+            min_length: 0.0,
         }
     }
 }
@@ -88,7 +94,7 @@ pub struct Simplification {
 /// let points: Vec<Point> = (0..=20).map(|i| Point::new(f64::from(i), 0.3 * f64::from(i % 2))).collect();
 /// let edges = (0..20u32).map(|i| GraphEdge { ends: [i, i + 1], labels: [1, 2] }).collect();
 /// let g = CurveGraph::new(points, edges)?;
-/// let s = simplify(&g, &SimplifyOptions { tolerance: 0.5 })?;
+/// let s = simplify(&g, &SimplifyOptions { tolerance: 0.5, ..Default::default() })?;
 /// assert_eq!(s.graph.edges().len(), 1);
 /// assert_eq!(s.chains[0].len(), 21);
 /// assert!(s.max_deviation <= 0.5);
@@ -99,9 +105,15 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(CurveError::BadTolerance { tolerance });
     }
+    let min_length = options.min_length;
+    if !(min_length.is_finite() && min_length >= 0.0) {
+        return Err(CurveError::BadTolerance {
+            tolerance: min_length,
+        });
+    }
     // Cutting the polylines and indexing the graph are independent.
     let (lines, index) = rayon::join(|| polylines(g), || Index::new(g));
-    let (kept, state) = simplify_lines(&lines, State::new(&index), tolerance);
+    let (kept, state) = simplify_lines(&lines, State::new(&index), options);
     let pieces = || {
         lines
             .iter()
@@ -155,7 +167,7 @@ pub fn simplify(g: &CurveGraph, options: &SimplifyOptions) -> Result<Simplificat
 fn simplify_lines<'a>(
     lines: &[Polyline],
     mut state: State<'a>,
-    tolerance: f64,
+    options: &SimplifyOptions,
 ) -> (Vec<Vec<usize>>, State<'a>) {
     let points = state.g().points();
     let extent: Vec<[f64; 2]> = lines
@@ -185,7 +197,7 @@ fn simplify_lines<'a>(
     let mut right = state.clone();
     let run = |state: &mut State<'a>, ids: &[usize]| -> Vec<Vec<usize>> {
         ids.iter()
-            .map(|&k| state.simplify_line(&lines[k], tolerance))
+            .map(|&k| state.simplify_line(&lines[k], options))
             .collect()
     };
     let (left_kept, right_kept) =
@@ -266,7 +278,8 @@ impl<'a> State<'a> {
     }
 
     /// Douglas–Peucker on one polyline; returns the indices (into `line.vertices`) kept.
-    fn simplify_line(&mut self, line: &Polyline, tolerance: f64) -> Vec<usize> {
+    fn simplify_line(&mut self, line: &Polyline, options: &SimplifyOptions) -> Vec<usize> {
+        let tolerance = options.tolerance;
         let v = &line.vertices;
         let mut scratch = std::mem::take(&mut self.scratch);
         let Scratch { keep, stack, .. } = &mut scratch;
@@ -309,6 +322,12 @@ impl<'a> State<'a> {
             kept
         } else {
             self.merge_pieces(line, &kept, &mut scratch, tolerance)
+        };
+        let kept = if kept.len() <= 2 || options.min_length <= 0.0 {
+            kept
+        } else {
+            let deviation = tolerance.max(0.5 * options.min_length);
+            self.join_short_pieces(line, kept, &mut scratch, options.min_length, deviation)
         };
         self.scratch = scratch;
         kept
@@ -433,6 +452,67 @@ impl<'a> State<'a> {
             a = b;
         }
         out
+    }
+
+    /// The third pass over a simplified polyline: a piece shorter than `min_length` loses one of
+    /// its inner ends (the one whose removal keeps the joined chord closer to the original
+    /// vertices, within `tolerance`, and passes the topology test), until no short piece can be
+    /// joined. The polyline's own ends (junctions, the domain's corners) stay. Returns the kept
+    /// indices left.
+    fn join_short_pieces(
+        &mut self,
+        line: &Polyline,
+        mut kept: Vec<usize>,
+        scratch: &mut Scratch,
+        min_length: f64,
+        tolerance: f64,
+    ) -> Vec<usize> {
+        let curve = &mut scratch.curve;
+        let v = &line.vertices;
+        let points = self.g().points();
+        let point = |k: usize| points[v[k] as usize];
+        let mut a = 0;
+        while a + 1 < kept.len() && kept.len() > 2 {
+            if point(kept[a]).distance_squared(point(kept[a + 1])) >= min_length * min_length {
+                a += 1;
+                continue;
+            }
+            // Remove kept[r], joining the pieces on either side of it.
+            let mut best: Option<(usize, f64)> = None;
+            for r in [a, a + 1] {
+                if r == 0 || r + 1 >= kept.len() {
+                    continue;
+                }
+                let (i, j) = (kept[r - 1], kept[r + 1]);
+                let (p, q) = (point(i), point(j));
+                let deviation = v[i + 1..j]
+                    .iter()
+                    .map(|&x| segment_distance_squared(p, q, points[x as usize]))
+                    .fold(0.0, f64::max)
+                    .sqrt();
+                if deviation > tolerance || best.is_some_and(|(_, d)| d <= deviation) {
+                    continue;
+                }
+                curve.clear();
+                curve.extend(kept[r - 1..=r + 1].iter().map(|&k| v[k]));
+                if self.shortcut_is_safe(curve, &v[i..=j], deviation) {
+                    best = Some((r, deviation));
+                }
+            }
+            let Some((r, deviation)) = best else {
+                a += 1;
+                continue;
+            };
+            curve.clear();
+            curve.extend(kept[r - 1..=r + 1].iter().map(|&k| v[k]));
+            self.replace(curve, r == 1 && r + 2 == kept.len());
+            self.max_deviation = self.max_deviation.max(deviation);
+            self.merged += 1;
+            kept.remove(r);
+            // The joined piece starts at kept[r - 1]: look at it (and the one before) again.
+            a = r.saturating_sub(2);
+        }
+        kept
     }
 
     /// A vertical line `x = split` (a grid column boundary) with about as many polyline vertices

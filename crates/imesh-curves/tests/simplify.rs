@@ -145,8 +145,18 @@ proptest! {
         let g = support::pixel_boundaries(&support::grid(w, h, labels));
         prop_assert_eq!(g.crossing(), None);
         for tolerance in TOLERANCES {
-            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            let s = simplify(&g, &SimplifyOptions { tolerance, ..Default::default() }).unwrap();
             check_simplification(&g, &s, tolerance);
+        }
+    }
+
+    /// The third pass (short pieces joined) keeps the topology too, within its looser bound.
+    #[test]
+    fn joining_short_pieces_keeps_the_topology((w, h, labels) in label_image()) {
+        let g = support::imesh_boundaries(&support::grid(w, h, labels));
+        for (tolerance, min_length) in [(0.5, 2.0), (2.0, 3.0), (2.0, 8.0)] {
+            let s = simplify(&g, &SimplifyOptions { tolerance, min_length }).unwrap();
+            check_simplification(&g, &s, tolerance.max(0.5 * min_length));
         }
     }
 
@@ -155,7 +165,7 @@ proptest! {
         let g = support::imesh_boundaries(&support::grid(w, h, labels));
         prop_assert_eq!(g.crossing(), None);
         for tolerance in TOLERANCES {
-            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            let s = simplify(&g, &SimplifyOptions { tolerance, ..Default::default() }).unwrap();
             check_simplification(&g, &s, tolerance);
         }
     }
@@ -184,7 +194,14 @@ fn a_loop_keeps_three_vertices_and_its_area_at_any_tolerance() {
         })
         .collect();
     let g = loop_graph(points);
-    let s = simplify(&g, &SimplifyOptions { tolerance: 1000.0 }).unwrap();
+    let s = simplify(
+        &g,
+        &SimplifyOptions {
+            tolerance: 1000.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert_eq!(s.graph.edges().len(), 3);
     check_simplification(&g, &s, 1000.0);
     let inner = s.graph.faces().into_iter().find(|f| f.label == 1).unwrap();
@@ -222,7 +239,14 @@ fn a_chord_never_jumps_over_an_island() {
         edge(n + 4, 0, [2, 3]),
     ]);
     let g = CurveGraph::new(points, edges).unwrap();
-    let s = simplify(&g, &SimplifyOptions { tolerance: 5.0 }).unwrap();
+    let s = simplify(
+        &g,
+        &SimplifyOptions {
+            tolerance: 5.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(s.refused > 0, "the chord over the island was refused");
     check_simplification(&g, &s, 5.0);
 }
@@ -248,7 +272,14 @@ fn two_curves_between_the_same_ends_do_not_merge() {
     let n = points.len() as u32;
     edges.extend([edge(n - 2, 0, [0, 0]), edge(1, n - 1, [0, 0])]);
     let g = CurveGraph::new(points, edges).unwrap();
-    let s = simplify(&g, &SimplifyOptions { tolerance: 5.0 }).unwrap();
+    let s = simplify(
+        &g,
+        &SimplifyOptions {
+            tolerance: 5.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     check_simplification(&g, &s, 5.0);
     assert_eq!(polylines(&g).len(), 4);
     assert!(s.refused > 0, "the second chord was refused");
@@ -306,7 +337,14 @@ fn real_fixture_boundaries_simplify_with_their_topology() {
         support::imesh_boundaries(&grid),
     ] {
         for tolerance in TOLERANCES {
-            let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+            let s = simplify(
+                &g,
+                &SimplifyOptions {
+                    tolerance,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
             check_simplification(&g, &s, tolerance);
             assert!(s.graph.edges().len() < g.edges().len());
         }
@@ -397,7 +435,13 @@ fn bad_graphs_and_tolerances_are_refused_with_typed_errors() {
     let g = CurveGraph::new(p, vec![edge(0, 1, [0, 1])]).unwrap();
     for tolerance in [-1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            simplify(&g, &SimplifyOptions { tolerance }),
+            simplify(
+                &g,
+                &SimplifyOptions {
+                    tolerance,
+                    ..Default::default()
+                }
+            ),
             Err(CurveError::BadTolerance { .. })
         ));
     }
@@ -426,7 +470,14 @@ fn fitted_curves_join_the_simplified_vertices_within_the_tolerance() {
     let grid = coins(3);
     let g = support::imesh_boundaries(&grid);
     for tolerance in [0.5, 2.0, 5.0] {
-        let s = simplify(&g, &SimplifyOptions { tolerance }).unwrap();
+        let s = simplify(
+            &g,
+            &SimplifyOptions {
+                tolerance,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let report = fit_edges(&s, &g, &FitOptions::default());
         assert_eq!(report.fits.len(), s.graph.edges().len());
         for (fit, e) in report.fits.iter().zip(s.graph.edges()) {
@@ -461,4 +512,38 @@ fn rms_to_edges(g: &CurveGraph, s: &Simplification) -> f64 {
         }
     }
     (sum / count as f64).sqrt()
+}
+
+/// A short piece between two long ones loses an inner end when the joined chord stays within
+/// half the smallest length of the original vertices, and keeps it when it would not.
+#[test]
+fn a_short_piece_is_joined_with_a_neighbour() {
+    let points = vec![
+        Point::new(0.0, 0.0),
+        Point::new(10.0, 0.0),
+        Point::new(11.0, 2.0),
+        Point::new(21.0, 2.0),
+    ];
+    let edges = (0..3u32).map(|i| edge(i, i + 1, [1, 2])).collect();
+    let g = CurveGraph::new(points, edges).unwrap();
+    let run = |min_length: f64| {
+        simplify(
+            &g,
+            &SimplifyOptions {
+                tolerance: 0.5,
+                min_length,
+            },
+        )
+        .unwrap()
+    };
+    // Douglas–Peucker alone keeps both bends (each 1.79 px off the other chords).
+    assert_eq!(run(0.0).graph.edges().len(), 3);
+    // A 2.24 px piece under 3 px, but joining it moves the boundary 1.79 > 1.5 px: kept.
+    assert_eq!(run(3.0).graph.edges().len(), 3);
+    // Under 4 px it may move the boundary 2 px: joined, both ends of the polyline kept.
+    let s = run(4.0);
+    assert_eq!(s.graph.edges().len(), 2);
+    assert!((s.max_deviation - 20.0 / 125f64.sqrt()).abs() < 1e-9);
+    let ends: Vec<[u32; 2]> = s.graph.edges().iter().map(|e| e.ends).collect();
+    assert!(ends.iter().any(|e| e.contains(&0)) && ends.iter().any(|e| e.contains(&3)));
 }

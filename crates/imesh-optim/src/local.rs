@@ -136,7 +136,8 @@ fn solve(
         setup,
     };
     let start = local.energy(Point::new(0.0, 0.0));
-    if !start.is_finite() || start == 0.0 {
+    // Settled: its quads already score well (a settled term of 0 still skips a perfect start).
+    if !start.is_finite() || start <= setup.settled_term * scratch.corners.len() as f64 {
         return None;
     }
     let size = (area / scratch.corners.len() as f64).abs().sqrt();

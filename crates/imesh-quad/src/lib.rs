@@ -28,7 +28,7 @@
 //! }
 //! let mut g = CurveGraph::new(points, edges)?;
 //! g.pin_domain_corners(20.0, 20.0);
-//! let s = simplify(&g, &SimplifyOptions { tolerance: 0.5 })?;
+//! let s = simplify(&g, &SimplifyOptions { tolerance: 0.5, ..Default::default() })?;
 //! let fits = fit_edges(&s, &g, &FitOptions::default());
 //! let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
 //! let r = remesh(&s.graph, &curves, &QuadOptions::default())?;
@@ -47,7 +47,7 @@ mod patch;
 mod template;
 
 pub use adapt::{adapt, AdaptReport, EdgeCurve, POOR_SCALED_JACOBIAN};
-pub use density::{uniform_points, CLEARANCE};
+pub use density::{uniform_points, BOUNDARY_PIECE, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, NONE};
 pub use mesh::{Holder, QuadMesh};
 pub use pairing::{Element, ElementMesh, Pairing};

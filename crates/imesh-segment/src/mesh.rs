@@ -47,13 +47,43 @@ impl SegmentedMesh {
     /// assert!(m.label_agreement(&grid) > 0.9);
     /// ```
     pub fn from_grid(grid: &LabelGrid, options: &SampleOptions) -> Result<Self, SegmentError> {
+        let sampling = sample(grid, options)?;
+        let label = partition(grid, &sampling.triangulation);
+        Self::from_partition(sampling, label, grid.width(), grid.height())
+    }
+
+    /// The segmented mesh of a sampling with a label per triangle slot (as [`partition`] gives,
+    /// possibly edited, e.g. by [`merge_thin_regions`](crate::merge_thin_regions)): the c-edges
+    /// are drawn between the labels and made segments.
+    ///
+    /// # Errors
+    /// A geometry error if the c-edges cannot be made segments (never expected).
+    ///
+    /// ```
+    /// use imesh_classify::{LabelGrid, Region};
+    /// use imesh_segment::{merge_thin_regions, partition, sample, SampleOptions, SegmentedMesh};
+    /// // A one-pixel line across a 20 × 20 image: merged away at a width of 2 px.
+    /// let labels = (0..400).map(|i| u32::from(i / 20 == 10)).collect();
+    /// let regions = vec![Region { name: "a".into(), colour: [0; 3] }, Region { name: "b".into(), colour: [255; 3] }];
+    /// let grid = LabelGrid::new(20, 20, labels, regions).unwrap();
+    /// let sampling = sample(&grid, &SampleOptions::default()).unwrap();
+    /// let mut label = partition(&grid, &sampling.triangulation);
+    /// assert!(merge_thin_regions(&sampling.triangulation, &mut label, 2.0).regions >= 1);
+    /// let m = SegmentedMesh::from_partition(sampling, label, 20, 20).unwrap();
+    /// assert!(m.c_edges.iter().all(|e| e.labels.contains(&imesh_segment::OUTSIDE)));
+    /// ```
+    pub fn from_partition(
+        sampling: Sampling,
+        label: Vec<u32>,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, SegmentError> {
         let Sampling {
             mut triangulation,
             inserted,
             rounds,
             ..
-        } = sample(grid, options)?;
-        let label = partition(grid, &triangulation);
+        } = sampling;
         let c_edges = c_edges(&triangulation, &label);
         for e in &c_edges {
             triangulation.insert_segment(e.vertices[0], e.vertices[1])?;
@@ -62,8 +92,8 @@ impl SegmentedMesh {
         Ok(Self {
             triangulation,
             c_edges,
-            width: grid.width(),
-            height: grid.height(),
+            width,
+            height,
             inserted,
             rounds,
         })

@@ -32,7 +32,9 @@ use imesh_quality::{
     average_quad_area, quad_corners, quad_values, validate, Domain, Element, Histogram, MeshView,
     QuadQuality, Statistics, TriangleQuality,
 };
-use imesh_segment::{SampleOptions, SegmentedMesh};
+use imesh_segment::{
+    merge_thin_regions, partition, sample, MergeReport, SampleOptions, SegmentedMesh,
+};
 use serde::{Deserialize, Serialize};
 
 /// Which elements to produce.
@@ -70,8 +72,8 @@ impl FromStr for PairingMethod {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(into = "String", try_from = "String")]
 pub enum ElementSize {
-    /// Uniform, at the spacing the simplified boundaries suggest: the upper quartile of their
-    /// edge lengths, at least [`MIN_AUTO_SPACING`] pixels, as the spacing of DT' (default).
+    /// Uniform, at a side chosen from the image's size and the width of its regions (default;
+    /// see [`AUTO_QUADS`] and [`MIN_AUTO_SIZE`]).
     Auto,
     /// Uniform quads of about this side, in pixels (DT' spacing: 2 × level × this).
     Pixels(f64),
@@ -83,9 +85,24 @@ pub enum ElementSize {
 /// Largest [`MeshOptions::majority`] radius: the filter costs (2R+1)² per pixel.
 pub const MAX_MAJORITY: u32 = 8;
 
-/// Smallest DT' spacing `--size auto` chooses, in pixels: finer boundaries than this are met by
-/// refinement, not by a finer lattice everywhere.
-pub const MIN_AUTO_SPACING: f64 = 4.0;
+/// Smallest quad side `--size auto` chooses, in pixels: the Imesh partition's vertices are
+/// pixel centres, so finer quads would only repeat the pixel staircase.
+pub const MIN_AUTO_SIZE: f64 = 2.0;
+
+/// About how many quads `--size auto` aims at over a whole image with wide regions.
+pub const AUTO_QUADS: f64 = 10_000.0;
+
+/// `--size auto` makes quads no larger than this share of the width below which a quarter of
+/// the boundaries lie ([`boundary_weighted_width`]).
+pub const AUTO_WIDTH_SHARE: f64 = 0.35;
+
+/// Boundary pieces shorter than this many quad sides are joined with a neighbour where the
+/// topology and a deviation of half their length allow ([`SimplifyOptions::min_length`]).
+pub const MIN_PIECE: f64 = 1.0;
+
+/// The automatic [`MeshOptions::min_width`], as a share of the quad size: a region thinner than
+/// half a quad can only be filled with quads of a fraction of the mean area.
+pub const AUTO_MIN_WIDTH: f64 = 0.5;
 
 impl FromStr for ElementSize {
     type Err = String;
@@ -221,13 +238,19 @@ pub struct MeshOptions {
     pub max_size: Option<f64>,
     /// Size of the quads: uniform (`auto`, or a side in pixels) or graded.
     pub size: ElementSize,
+    /// Regions of the partition thinner than this many pixels (twice their area over their
+    /// perimeter) are merged into the neighbour they share the longest boundary with, on the
+    /// quad path: `None` (auto) is half the quad size of a uniform mesh and nothing for a
+    /// graded one; 0 keeps every region.
+    pub min_width: Option<f64>,
     /// Regions (4-connected) smaller than this many pixels are merged into the neighbour they
     /// share the longest border with before meshing (0: every region is kept).
     pub min_region: usize,
     /// Radius of a majority filter applied to the labels before meshing (0: none): every pixel
     /// takes the label most common in its (2R+1)² window, which removes specks, notches and
-    /// strips thinner than about R pixels.
-    pub majority: u32,
+    /// strips thinner than about R pixels. `None` (auto): about one quad side for a uniform
+    /// quad mesh ([`auto_majority`]), none for a graded one or triangles.
+    pub majority: Option<u32>,
     /// Curve simplification tolerance in pixels (quads).
     pub tolerance: f64,
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² (1–8).
@@ -266,8 +289,9 @@ impl Default for MeshOptions {
             max_steiner: None,
             max_size: None,
             size: ElementSize::Auto,
+            min_width: None,
             min_region: 0,
-            majority: 0,
+            majority: None,
             tolerance: imesh_curves::DEFAULT_TOLERANCE,
             template_level: 1,
             pairing: PairingMethod::Matching,
@@ -349,10 +373,16 @@ pub struct Counts {
     /// Labels in the label grid.
     pub labels: usize,
     /// Pixels whose label the clean-up (`majority`, `min_region`) changed; label agreement is
-    /// measured against the cleaned grid.
+    /// measured against the image's own labels, so they count against it.
     pub cleaned_pixels: usize,
     /// Pixel centres Imesh sampled.
     pub sampled_vertices: usize,
+    /// Regions of the partition merged into a neighbour for being thinner than `min_width`.
+    pub merged_regions: usize,
+    /// Their area in square pixels.
+    pub merged_area: f64,
+    /// The side of the quads of a uniform mesh, in pixels (0 when graded or for triangles).
+    pub quad_size: f64,
     /// c-edges of the partition.
     pub c_edges: usize,
     /// Points the refinement inserted.
@@ -759,19 +789,37 @@ impl Pipeline {
         self.check_options()?;
         self.check_size(grid.width(), grid.height())?;
         let start = Instant::now();
-        let cleaned = self.clean_up(grid);
+        let quad_size = match o.elements {
+            Elements::Quad => self.quad_size(grid),
+            Elements::Tri => None,
+        };
+        let majority = o
+            .majority
+            .unwrap_or_else(|| quad_size.map_or(0, auto_majority));
+        let original = grid;
+        let cleaned = self.clean_up(grid, majority);
         let (grid, cleaned_pixels) = match &cleaned {
             Some((g, changed)) => (g, *changed),
             None => (grid, 0),
         };
         self.stage(Stage::Sample);
-        let mut segmented = SegmentedMesh::from_grid(
+        let sampling = sample(
             grid,
             &SampleOptions {
                 te: o.te,
                 ..Default::default()
             },
         )?;
+        let mut label = partition(grid, &sampling.triangulation);
+        let min_width = o
+            .min_width
+            .unwrap_or_else(|| quad_size.map_or(0.0, |q| AUTO_MIN_WIDTH * q));
+        let merged = match o.elements {
+            Elements::Quad => merge_thin_regions(&sampling.triangulation, &mut label, min_width),
+            Elements::Tri => MergeReport::default(),
+        };
+        let mut segmented =
+            SegmentedMesh::from_partition(sampling, label, grid.width(), grid.height())?;
         let mut seconds = StageSeconds {
             classify: classified,
             sample: start.elapsed().as_secs_f64(),
@@ -783,6 +831,9 @@ impl Pipeline {
             height: h,
             labels: grid.num_labels(),
             sampled_vertices: segmented.inserted,
+            merged_regions: merged.regions,
+            merged_area: merged.area,
+            quad_size: quad_size.unwrap_or(0.0),
             c_edges: segmented.c_edges.len(),
             cleaned_pixels,
             ..Default::default()
@@ -825,6 +876,7 @@ impl Pipeline {
             Elements::Tri => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
             Elements::Quad => self.quads(
                 &segmented,
+                quad_size,
                 &mut counts,
                 &mut seconds,
                 &mut optimised,
@@ -890,7 +942,29 @@ impl Pipeline {
             width: w,
             height: h,
         };
-        let label_agreement = label_agreement(&mesh, grid);
+        // Against the image's own labels, so that the clean-up's changes count as disagreement
+        // (the cleaned grid may number its labels differently: match them by name).
+        let label_agreement = if cleaned.is_some() {
+            let id: std::collections::HashMap<&str, u32> = original
+                .regions()
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (r.name.as_str(), i as u32))
+                .collect();
+            let labels: Vec<u32> = mesh
+                .labels
+                .iter()
+                .map(|&l| {
+                    grid.regions()
+                        .get(l as usize)
+                        .and_then(|r| id.get(r.name.as_str()).copied())
+                        .unwrap_or(u32::MAX)
+                })
+                .collect();
+            agreement(&mesh.vertices, &mesh.elements, &labels, original)
+        } else {
+            label_agreement(&mesh, grid)
+        };
         seconds.check = check.elapsed().as_secs_f64();
         seconds.total = classified + start.elapsed().as_secs_f64();
         let report = Report {
@@ -965,6 +1039,7 @@ impl Pipeline {
     fn quads(
         &self,
         segmented: &SegmentedMesh,
+        quad_size: Option<f64>,
         counts: &mut Counts,
         seconds: &mut StageSeconds,
         optimised: &mut Option<QuadExtras>,
@@ -978,6 +1053,7 @@ impl Pipeline {
             &g,
             &SimplifyOptions {
                 tolerance: o.tolerance,
+                min_length: quad_size.map_or(0.0, |q| MIN_PIECE * q),
             },
         )?;
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
@@ -994,7 +1070,7 @@ impl Pipeline {
             (Vec::new(), Vec::new(), Vec::new(), lines)
         });
         self.stage(Stage::Quads);
-        let spacing = self.dt_spacing(&simplified.graph);
+        let spacing = quad_size.map(|q| 2.0 * f64::from(o.template_level) * q);
         let mut r = remesh(
             &simplified.graph,
             &curves,
@@ -1140,14 +1216,14 @@ impl Pipeline {
     /// inserted point adds about two triangles).
     /// The label grid after the clean-up the options ask for (a majority filter, then merging
     /// small regions), with the number of pixels whose label changed; `None` without clean-up.
-    fn clean_up(&self, grid: &LabelGrid) -> Option<(LabelGrid, usize)> {
+    fn clean_up(&self, grid: &LabelGrid, majority: u32) -> Option<(LabelGrid, usize)> {
         let o = &self.options;
-        if o.majority == 0 && o.min_region <= 1 {
+        if majority == 0 && o.min_region <= 1 {
             return None;
         }
         let mut cleaned = grid.clone();
-        if o.majority > 0 {
-            cleaned = imesh_classify::majority_filter(&cleaned, o.majority, 1);
+        if majority > 0 {
+            cleaned = imesh_classify::majority_filter(&cleaned, majority, 1);
         }
         if o.min_region > 1 {
             cleaned = imesh_classify::remove_small_regions(&cleaned, o.min_region);
@@ -1165,25 +1241,23 @@ impl Pipeline {
         Some((cleaned, changed))
     }
 
-    /// The spacing of a uniform DT' over G', if the size asks for one.
-    fn dt_spacing(&self, g: &imesh_curves::CurveGraph) -> Option<f64> {
-        let o = &self.options;
-        match o.size {
+    /// The side of the quads of a uniform mesh, in pixels (`None` when graded). `auto` takes
+    /// the smaller of two sizes, and at least [`MIN_AUTO_SIZE`]: the one that gives about
+    /// [`AUTO_QUADS`] quads over the image, and [`AUTO_WIDTH_SHARE`] of the width under which a
+    /// quarter of the boundaries lie ([`boundary_weighted_width`] of the label grid's regions,
+    /// before any clean-up), so that most regions are crossed by several quads.
+    fn quad_size(&self, grid: &LabelGrid) -> Option<f64> {
+        match self.options.size {
             ElementSize::Graded => None,
-            ElementSize::Pixels(px) => Some(2.0 * f64::from(o.template_level) * px),
+            ElementSize::Pixels(px) => Some(px),
             ElementSize::Auto => {
-                let mut lengths: Vec<f64> = g
-                    .edges()
-                    .iter()
-                    .map(|e| {
-                        g.point(e.ends[0])
-                            .distance_squared(g.point(e.ends[1]))
-                            .sqrt()
-                    })
-                    .collect();
-                lengths.sort_by(f64::total_cmp);
-                let quartile = lengths.get(3 * lengths.len() / 4).copied().unwrap_or(0.0);
-                Some(quartile.max(MIN_AUTO_SPACING))
+                let area = f64::from(grid.width()) * f64::from(grid.height());
+                let by_count = (area / AUTO_QUADS).sqrt();
+                let regions = imesh_classify::pixel_regions(grid);
+                let widths = regions.iter().map(|r| (r.width(), r.perimeter as f64));
+                let narrowest = 2.0 * AUTO_MIN_WIDTH * MIN_AUTO_SIZE;
+                let by_width = AUTO_WIDTH_SHARE * boundary_weighted_width(widths, 0.25, narrowest);
+                Some(by_count.min(by_width).max(MIN_AUTO_SIZE))
             }
         }
     }
@@ -1231,11 +1305,17 @@ impl Pipeline {
                 o.template_level
             )));
         }
-        if o.majority > MAX_MAJORITY {
+        if o.majority.is_some_and(|r| r > MAX_MAJORITY) {
             return Err(PipelineError::Options(format!(
                 "the majority filter radius {} is too large: give 0 to {MAX_MAJORITY} pixels \
                  (use --min-region for larger specks)",
-                o.majority
+                o.majority.unwrap_or_default()
+            )));
+        }
+        if let Some(w) = o.min_width.filter(|w| !(w.is_finite() && *w >= 0.0)) {
+            return Err(PipelineError::Options(format!(
+                "the smallest region width must be a distance in pixels ≥ 0 (0 keeps every \
+                 region), not {w}"
             )));
         }
         if !(o.tolerance.is_finite() && o.tolerance >= 0.0) {
@@ -1271,6 +1351,55 @@ type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
 /// curve stage's input).
 ///
 /// # Errors
+/// The radius of the majority filter that `--majority auto` applies before a uniform mesh of
+/// quad side `quad_size`: about one quad, so that notches, specks and strips the quads could
+/// only follow with small elements are smoothed away (1 to [`MAX_MAJORITY`] pixels).
+///
+/// ```
+/// assert_eq!(imesh::auto_majority(2.56), 3);
+/// assert_eq!(imesh::auto_majority(0.3), 1);
+/// assert_eq!(imesh::auto_majority(40.0), imesh::MAX_MAJORITY);
+/// ```
+pub fn auto_majority(quad_size: f64) -> u32 {
+    (quad_size.round().max(1.0) as u32).min(MAX_MAJORITY)
+}
+
+/// The width below which a share `share` of the boundaries lie: `(width, perimeter)` of each
+/// region, sorted by width and weighted by perimeter (a boundary counts once for each region
+/// along it), those narrower than `narrowest` left out; 0 when none is left.
+///
+/// The boundaries are where a mesh of one element size must fit its elements between curves,
+/// so they, not the area (which a background dominates), say which widths matter.
+///
+/// ```
+/// use imesh::boundary_weighted_width;
+/// // A speck (width 0.5), a region of width 10 and perimeter 20, one of width 2 and perimeter 60.
+/// let regions = [(0.5, 4.0), (10.0, 20.0), (2.0, 60.0)];
+/// assert_eq!(boundary_weighted_width(regions, 0.5, 1.0), 2.0);
+/// assert_eq!(boundary_weighted_width(regions, 0.9, 1.0), 10.0);
+/// assert_eq!(boundary_weighted_width(regions, 0.02, 0.0), 0.5);
+/// ```
+pub fn boundary_weighted_width(
+    regions: impl IntoIterator<Item = (f64, f64)>,
+    share: f64,
+    narrowest: f64,
+) -> f64 {
+    let mut by_width: Vec<(f64, f64)> = regions
+        .into_iter()
+        .filter(|&(w, _)| w >= narrowest)
+        .collect();
+    by_width.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = by_width.iter().map(|&(_, p)| p).sum();
+    let mut below = 0.0;
+    for &(w, p) in &by_width {
+        below += p;
+        if below >= share * total {
+            return w;
+        }
+    }
+    by_width.last().map_or(0.0, |&(w, _)| w)
+}
+
 /// [`imesh_curves::CurveError`] if the c-edges do not make a valid graph (a bug in the sampler).
 pub fn boundary_graph(segmented: &SegmentedMesh) -> Result<CurveGraph, imesh_curves::CurveError> {
     let edges = segmented
@@ -1298,16 +1427,21 @@ fn equilateral_area(s: f64) -> f64 {
 /// between two elements, either counts). Elements are convex (positive Jacobian at every corner),
 /// so a centre is inside when it is on the inner side of every edge.
 pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
+    agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid)
+}
+
+/// [`label_agreement`] of elements with their own labels (numbered as `grid`'s).
+fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: &LabelGrid) -> f64 {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
     if w == 0 || h == 0 {
         return 1.0;
     }
     let mut agrees = vec![false; w * h];
-    for (element, &label) in mesh.elements.iter().zip(&mesh.labels) {
+    for (element, &label) in elements.iter().zip(labels) {
         let corners: Vec<[f64; 2]> = element
             .corners()
             .iter()
-            .map(|&v| mesh.vertices[v as usize])
+            .map(|&v| vertices[v as usize])
             .collect();
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for c in &corners {

@@ -135,9 +135,15 @@ struct MeshFlags {
     #[arg(long)]
     min_region: Option<usize>,
     /// Majority filter of this radius over the labels before meshing: removes specks, notches
-    /// and strips thinner than about the radius [default: 0, none].
+    /// and strips thinner than about the radius; 0 for none [default: auto, about one quad side
+    /// for uniform quads, none otherwise].
     #[arg(long)]
-    majority: Option<u32>,
+    majority: Option<AutoOr<u32>>,
+    /// Merge regions thinner than this many pixels (twice their area over their perimeter) into
+    /// their neighbour (quads); 0 keeps every region [default: auto, half the quad side for
+    /// uniform quads, none otherwise].
+    #[arg(long)]
+    min_width: Option<AutoOr<f64>>,
     /// Curve simplification tolerance in pixels [default: 2].
     #[arg(long)]
     tolerance: Option<f64>,
@@ -274,7 +280,10 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
         o.min_region = n;
     }
     if let Some(r) = args.majority {
-        o.majority = r;
+        o.majority = r.value();
+    }
+    if let Some(w) = args.min_width {
+        o.min_width = w.value();
     }
     if let Some(e) = args.elements {
         o.elements = e;
@@ -727,5 +736,34 @@ fn check_png(path: &Path) -> Result<(), String> {
             "cannot write {}: the label image is a PNG, use a name ending in .png",
             path.display()
         ))
+    }
+}
+
+/// An option value that may be `auto` (the pipeline chooses).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum AutoOr<T> {
+    Auto,
+    Value(T),
+}
+
+impl<T> AutoOr<T> {
+    /// `None` for auto, as the pipeline's options say it.
+    fn value(self) -> Option<T> {
+        match self {
+            Self::Auto => None,
+            Self::Value(v) => Some(v),
+        }
+    }
+}
+
+impl<T: std::str::FromStr> std::str::FromStr for AutoOr<T> {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(Self::Auto);
+        }
+        s.parse()
+            .map(Self::Value)
+            .map_err(|_| format!("{s:?} is neither auto nor a number"))
     }
 }

@@ -100,7 +100,9 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     );
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
-    assert!(report["label_agreement"].as_f64().unwrap() > 0.97);
+    // Against the map's own labels: the default smooths them over about one quad first.
+    assert!(report["label_agreement"].as_f64().unwrap() > 0.95);
+    assert!(report["counts"]["cleaned_pixels"].as_u64().unwrap() > 0);
     // DESIGN.md §6's stable keys.
     assert_eq!(
         report["fidelity"]["label_agreement"],
@@ -219,18 +221,29 @@ fn the_triangle_mesh_and_quad_options() {
     assert!(tri["quality"]["min_angle_deg"]["mean"].as_f64().unwrap() > 30.0);
     let inp = std::fs::read_to_string(dir.path().join("m.inp")).unwrap();
     assert!(inp.contains("CPS3") && !inp.contains("CPS4"));
-    let level1 = run(&["--pairing", "greedy"], "g1.json");
-    let level2 = run(&["--pairing", "greedy", "--template-level", "2"], "g2.json");
+    // Graded, DT' does not depend on the level (a uniform size is the quads' own).
+    let level1 = run(&["--pairing", "greedy", "--size", "graded"], "g1.json");
+    let level2 = run(
+        &[
+            "--pairing",
+            "greedy",
+            "--size",
+            "graded",
+            "--template-level",
+            "2",
+        ],
+        "g2.json",
+    );
     let quads = |r: &serde_json::Value| r["counts"]["quads"].as_u64().unwrap();
     assert_eq!(
         quads(&level2),
         4 * quads(&level1),
         "level 2 splits every quad in four"
     );
-    let matching = run(&["--pairing", "matching"], "m.json");
+    let matching = run(&["--pairing", "matching", "--size", "graded"], "m.json");
     let unpaired = |r: &serde_json::Value| r["counts"]["unpaired_triangles"].as_u64().unwrap();
     assert!(unpaired(&matching) < unpaired(&level1));
-    let coarse = run(&["--tolerance", "5"], "t5.json");
+    let coarse = run(&["--tolerance", "5", "--size", "graded"], "t5.json");
     let edges = |r: &serde_json::Value| r["counts"]["simplified_edges"].as_u64().unwrap();
     assert!(edges(&coarse) < edges(&matching));
     // Optimisation: the default (local, shape-and-size) reports the quality before it and
@@ -265,7 +278,7 @@ fn the_triangle_mesh_and_quad_options() {
         worst_after >= worst_before * (1.0 - 1e-12),
         "worst shape-and-size {worst_before} → {worst_after}"
     );
-    let none = run(&["--optimizer", "none"], "none.json");
+    let none = run(&["--optimizer", "none", "--size", "graded"], "none.json");
     for metric in ["shape_and_size", "shape", "scaled_jacobian"] {
         for s in ["min", "mean"] {
             let unoptimised = stat(&none, "quality", metric, s);
@@ -310,6 +323,11 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--template-level", "9"], "1 to 8"),
         (&["mesh", image, "--tolerance=-1"], "tolerance"),
         (&["mesh", image, "--pairing", "best"], "greedy or matching"),
+        (
+            &["mesh", image, "--majority", "some"],
+            "neither auto nor a number",
+        ),
+        (&["mesh", image, "--min-width=-2"], "smallest region width"),
         (
             &["mesh", image, "--size", "big"],
             "auto, graded or a positive",

@@ -30,7 +30,7 @@ fn degenerate_images_give_valid_all_quad_meshes() {
         MeshOptions {
             size: ElementSize::Auto,
             min_region: 4,
-            majority: 1,
+            majority: Some(1),
             ..Default::default()
         },
     ];
@@ -88,8 +88,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             "{}",
             path.display()
         );
+        // Against the image's own labels: the default clean-up smooths them over about one
+        // quad, which costs most on the pixel noise of a thresholded texture (grass: 0.83).
         assert!(
-            r.label_agreement > 0.9,
+            r.label_agreement > 0.8,
             "{}: {}",
             path.display(),
             r.label_agreement
@@ -125,20 +127,22 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         ..Default::default()
     });
     let auto = run(MeshOptions::default());
-    let uniform = run(MeshOptions {
+    // No clean-up at all: the automatic majority filter and region merging off.
+    let bare = MeshOptions {
         size: ElementSize::Pixels(3.0),
+        majority: Some(0),
+        min_width: Some(0.0),
         ..Default::default()
-    });
+    };
+    let uniform = run(bare.clone());
     let cleaned = run(MeshOptions {
-        size: ElementSize::Pixels(3.0),
         min_region: 50,
-        ..Default::default()
+        ..bare.clone()
     });
     let smoothed = run(MeshOptions {
-        size: ElementSize::Pixels(3.0),
         min_region: 50,
-        majority: 2,
-        ..Default::default()
+        majority: Some(2),
+        ..bare
     });
     for r in [&graded, &auto, &uniform, &cleaned, &smoothed] {
         assert!(r.validation.valid && r.quality.scaled_jacobian().min > 0.0);
@@ -152,13 +156,21 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         mean(&cleaned),
         mean(&smoothed)
     );
-    assert!(mean(&auto) > mean(&graded) + 0.1);
-    assert!(auto.counts.dt_spacing >= imesh::MIN_AUTO_SPACING);
+    // The default: a uniform size from the image, the labels smoothed over about one quad and
+    // the regions thinner than half a quad merged.
+    assert!(auto.counts.quad_size >= imesh::MIN_AUTO_SIZE);
+    assert!(auto.counts.cleaned_pixels > 0 && auto.counts.merged_regions > 0);
+    assert!(mean(&auto) > 0.7, "default mean {:.3}", mean(&auto));
+    assert!(mean(&auto) > mean(&smoothed));
+    // Measured against the image's own labels, the clean-up costs some agreement, not much.
+    assert!(auto.label_agreement > 0.95 && auto.label_agreement < uniform.label_agreement);
     assert!(mean(&uniform) > mean(&graded) + 0.2);
     assert!(mean(&cleaned) > mean(&uniform) + 0.1);
     assert_eq!(graded.counts.dt_spacing, 0.0);
+    assert_eq!(graded.counts.quad_size, 0.0);
     assert_eq!(uniform.counts.dt_spacing, 6.0);
     assert_eq!(uniform.counts.cleaned_pixels, 0);
+    assert_eq!(uniform.counts.merged_regions, 0);
     assert!(cleaned.counts.cleaned_pixels > 0);
     assert!(mean(&smoothed) > mean(&cleaned) + 0.05);
     assert!(smoothed.counts.cleaned_pixels > cleaned.counts.cleaned_pixels);

@@ -70,7 +70,13 @@ fn options() -> impl Strategy<Value = MeshOptions> {
             ElementSize::Pixels(1.0),
             ElementSize::Pixels(4.0),
         ]),
-        prop::sample::select(vec![(0usize, 0u32), (0, 0), (30, 0), (0, 2), (20, 1)]),
+        prop::sample::select(vec![
+            (0usize, None),
+            (0, Some(0u32)),
+            (30, Some(0)),
+            (0, Some(2)),
+            (20, Some(1)),
+        ]),
     )
         .prop_map(
             |(
