@@ -313,13 +313,7 @@ pub fn simplify(data: &[u8]) {
         Err(e) => panic!("c-edge graph: {e}"),
     };
     assert_eq!(g.crossing(), None, "the c-edges cross");
-    let s = match imesh_curves::simplify(
-        &g,
-        &SimplifyOptions {
-            tolerance,
-            ..Default::default()
-        },
-    ) {
+    let s = match imesh_curves::simplify(&g, &SimplifyOptions::with_tolerance(tolerance)) {
         Ok(s) => s,
         Err(e) => panic!("simplify: {e}"),
     };

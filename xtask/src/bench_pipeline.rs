@@ -161,46 +161,25 @@ fn line(r: &Row) -> String {
     )
 }
 
-/// The paper's Figure 8 densities (about 1.2 K, 5 K and 10 K quads) on the MRI fixture, with the
-/// paper's graded size: coarser than the defaults by the Imesh threshold and the curve
-/// tolerance, finer by a largest element size.
+/// The paper's Figure 8 densities (about 1.2 K, 5 K and 10 K quads) on the MRI fixture: the
+/// default (uniform, its size chosen from the image) and two larger quad sizes.
 fn densities() -> [(&'static str, MeshOptions); 3] {
+    let size = |px: f64| MeshOptions {
+        size: imesh::ElementSize::Pixels(px),
+        ..MeshOptions::default()
+    };
     [
-        (
-            "MRI, --te 0.5 --tolerance 10",
-            MeshOptions {
-                te: 0.5,
-                tolerance: 10.0,
-                size: imesh::ElementSize::Graded,
-                ..MeshOptions::default()
-            },
-        ),
-        (
-            "MRI, --max-size 10",
-            MeshOptions {
-                max_size: Some(10.0),
-                size: imesh::ElementSize::Graded,
-                ..MeshOptions::default()
-            },
-        ),
-        (
-            "MRI, --max-size 7",
-            MeshOptions {
-                max_size: Some(7.0),
-                size: imesh::ElementSize::Graded,
-                ..MeshOptions::default()
-            },
-        ),
+        ("MRI, --size 7.5", size(7.5)),
+        ("MRI, --size 3.6", size(3.6)),
+        ("MRI, default", MeshOptions::default()),
     ]
 }
 
-/// The uniform-size options of the second table: quads about 3 px wide, specks under 50 px
-/// merged and the labels smoothed by a radius-2 majority filter first.
+/// The options of the last fixture table: the default clean-up without the automatic size, at
+/// quads 3 px wide on every image.
 fn uniform() -> MeshOptions {
     MeshOptions {
         size: imesh::ElementSize::Pixels(3.0),
-        min_region: 50,
-        majority: Some(2),
         ..MeshOptions::default()
     }
 }
@@ -284,7 +263,7 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
         &graded_fixtures,
     );
     table(
-        "Every fixture, uniform size: --size 3 --min-region 50 --majority 2",
+        "Every fixture, one quad size for all: --size 3",
         &uniform_fixtures,
     );
 

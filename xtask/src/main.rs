@@ -44,8 +44,8 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
     --global-iterations N   Powell iterations of the global mode (default 10)
 
   bench pipeline   the whole run on every fixture as the paper's Table I (counts, seconds per
-                   stage, quality), again at a uniform size (--size 3 --min-region 50
-                   --majority 2), one image at three densities (Figure 8 / Table II), and the
+                   stage, quality), again graded and at one quad size (--size 3), one image
+                   at three densities (Figure 8 / Table II), and the
                    camera fixture resized 256² … 4096² (seconds and peak heap per stage);
                    writes target/bench/pipeline.md and pipeline.json
     --scaling-max SIDE   largest side of the scaling series (default 4096)

@@ -22,7 +22,7 @@
 //!     .collect();
 //! let edges = (0..64u32).map(|i| GraphEdge { ends: [i, (i + 1) % 64], labels: [1, 0] }).collect();
 //! let g = CurveGraph::new(points, edges)?;
-//! let s = simplify(&g, &SimplifyOptions { tolerance: 1.0, ..Default::default() })?;
+//! let s = simplify(&g, &SimplifyOptions::with_tolerance(1.0))?;
 //! assert!(s.graph.edges().len() < 64 && s.graph.edges().len() >= 3);
 //! let report = fit_edges(&s, &g, &FitOptions::default());
 //! assert!(report.max_error < 0.05); // cubics follow the circle far better than the chords

@@ -51,6 +51,21 @@ pub struct SimplifyOptions {
     pub min_length: f64,
 }
 
+impl SimplifyOptions {
+    /// Douglas–Peucker at `tolerance` pixels, without the third pass.
+    ///
+    /// ```
+    /// let o = imesh_curves::SimplifyOptions::with_tolerance(3.0);
+    /// assert_eq!((o.tolerance, o.min_length), (3.0, 0.0));
+    /// ```
+    pub fn with_tolerance(tolerance: f64) -> Self {
+        Self {
+            tolerance,
+            ..Self::default()
+        }
+    }
+}
+
 impl Default for SimplifyOptions {
     fn default() -> Self {
         Self {
@@ -94,7 +109,7 @@ pub struct Simplification {
 /// let points: Vec<Point> = (0..=20).map(|i| Point::new(f64::from(i), 0.3 * f64::from(i % 2))).collect();
 /// let edges = (0..20u32).map(|i| GraphEdge { ends: [i, i + 1], labels: [1, 2] }).collect();
 /// let g = CurveGraph::new(points, edges)?;
-/// let s = simplify(&g, &SimplifyOptions { tolerance: 0.5, ..Default::default() })?;
+/// let s = simplify(&g, &SimplifyOptions::with_tolerance(0.5))?;
 /// assert_eq!(s.graph.edges().len(), 1);
 /// assert_eq!(s.chains[0].len(), 21);
 /// assert!(s.max_deviation <= 0.5);

@@ -145,7 +145,7 @@ proptest! {
         let g = support::pixel_boundaries(&support::grid(w, h, labels));
         prop_assert_eq!(g.crossing(), None);
         for tolerance in TOLERANCES {
-            let s = simplify(&g, &SimplifyOptions { tolerance, ..Default::default() }).unwrap();
+            let s = simplify(&g, &SimplifyOptions::with_tolerance(tolerance)).unwrap();
             check_simplification(&g, &s, tolerance);
         }
     }
@@ -165,7 +165,7 @@ proptest! {
         let g = support::imesh_boundaries(&support::grid(w, h, labels));
         prop_assert_eq!(g.crossing(), None);
         for tolerance in TOLERANCES {
-            let s = simplify(&g, &SimplifyOptions { tolerance, ..Default::default() }).unwrap();
+            let s = simplify(&g, &SimplifyOptions::with_tolerance(tolerance)).unwrap();
             check_simplification(&g, &s, tolerance);
         }
     }
@@ -194,14 +194,7 @@ fn a_loop_keeps_three_vertices_and_its_area_at_any_tolerance() {
         })
         .collect();
     let g = loop_graph(points);
-    let s = simplify(
-        &g,
-        &SimplifyOptions {
-            tolerance: 1000.0,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let s = simplify(&g, &SimplifyOptions::with_tolerance(1000.0)).unwrap();
     assert_eq!(s.graph.edges().len(), 3);
     check_simplification(&g, &s, 1000.0);
     let inner = s.graph.faces().into_iter().find(|f| f.label == 1).unwrap();
@@ -239,14 +232,7 @@ fn a_chord_never_jumps_over_an_island() {
         edge(n + 4, 0, [2, 3]),
     ]);
     let g = CurveGraph::new(points, edges).unwrap();
-    let s = simplify(
-        &g,
-        &SimplifyOptions {
-            tolerance: 5.0,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let s = simplify(&g, &SimplifyOptions::with_tolerance(5.0)).unwrap();
     assert!(s.refused > 0, "the chord over the island was refused");
     check_simplification(&g, &s, 5.0);
 }
@@ -272,14 +258,7 @@ fn two_curves_between_the_same_ends_do_not_merge() {
     let n = points.len() as u32;
     edges.extend([edge(n - 2, 0, [0, 0]), edge(1, n - 1, [0, 0])]);
     let g = CurveGraph::new(points, edges).unwrap();
-    let s = simplify(
-        &g,
-        &SimplifyOptions {
-            tolerance: 5.0,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let s = simplify(&g, &SimplifyOptions::with_tolerance(5.0)).unwrap();
     check_simplification(&g, &s, 5.0);
     assert_eq!(polylines(&g).len(), 4);
     assert!(s.refused > 0, "the second chord was refused");
@@ -337,14 +316,7 @@ fn real_fixture_boundaries_simplify_with_their_topology() {
         support::imesh_boundaries(&grid),
     ] {
         for tolerance in TOLERANCES {
-            let s = simplify(
-                &g,
-                &SimplifyOptions {
-                    tolerance,
-                    ..Default::default()
-                },
-            )
-            .unwrap();
+            let s = simplify(&g, &SimplifyOptions::with_tolerance(tolerance)).unwrap();
             check_simplification(&g, &s, tolerance);
             assert!(s.graph.edges().len() < g.edges().len());
         }
@@ -435,13 +407,7 @@ fn bad_graphs_and_tolerances_are_refused_with_typed_errors() {
     let g = CurveGraph::new(p, vec![edge(0, 1, [0, 1])]).unwrap();
     for tolerance in [-1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            simplify(
-                &g,
-                &SimplifyOptions {
-                    tolerance,
-                    ..Default::default()
-                }
-            ),
+            simplify(&g, &SimplifyOptions::with_tolerance(tolerance)),
             Err(CurveError::BadTolerance { .. })
         ));
     }
@@ -470,14 +436,7 @@ fn fitted_curves_join_the_simplified_vertices_within_the_tolerance() {
     let grid = coins(3);
     let g = support::imesh_boundaries(&grid);
     for tolerance in [0.5, 2.0, 5.0] {
-        let s = simplify(
-            &g,
-            &SimplifyOptions {
-                tolerance,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let s = simplify(&g, &SimplifyOptions::with_tolerance(tolerance)).unwrap();
         let report = fit_edges(&s, &g, &FitOptions::default());
         assert_eq!(report.fits.len(), s.graph.edges().len());
         for (fit, e) in report.fits.iter().zip(s.graph.edges()) {

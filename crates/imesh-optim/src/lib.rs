@@ -34,7 +34,7 @@
 //! }
 //! let mut g = CurveGraph::new(points, edges)?;
 //! g.pin_domain_corners(20.0, 20.0);
-//! let s = simplify(&g, &SimplifyOptions { tolerance: 0.5, ..Default::default() })?;
+//! let s = simplify(&g, &SimplifyOptions::with_tolerance(0.5))?;
 //! let fits = fit_edges(&s, &g, &FitOptions::default());
 //! let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
 //! let mut r = remesh(&s.graph, &curves, &QuadOptions::default())?;

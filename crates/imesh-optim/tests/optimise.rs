@@ -13,14 +13,7 @@ mod support;
 
 fn quad_mesh(grid: &LabelGrid) -> Remesh {
     let g = support::imesh_boundaries(grid);
-    let s = simplify(
-        &g,
-        &SimplifyOptions {
-            tolerance: 2.0,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let s = simplify(&g, &SimplifyOptions::with_tolerance(2.0)).unwrap();
     let fits = fit_edges(&s, &g, &FitOptions::default());
     let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
     remesh(&s.graph, &curves, &QuadOptions::default()).unwrap()

@@ -31,14 +31,7 @@ struct Curves {
 fn curves(grid: &LabelGrid) -> Curves {
     let original = support::imesh_boundaries(grid);
     let (width, height) = (f64::from(grid.width()), f64::from(grid.height()));
-    let simplified = simplify(
-        &original,
-        &SimplifyOptions {
-            tolerance: TOLERANCE,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let simplified = simplify(&original, &SimplifyOptions::with_tolerance(TOLERANCE)).unwrap();
     let fits = fit_edges(&simplified, &original, &FitOptions::default());
     Curves {
         original,

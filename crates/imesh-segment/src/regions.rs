@@ -9,7 +9,7 @@
 //! the c-edges are drawn. The width of a region is `2 · area / perimeter`: the width of a long
 //! strip, the radius of a disc, half the side of a square.
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 use imesh_geom::Triangulation;
 
@@ -56,8 +56,9 @@ pub struct PartitionRegions {
     pub of_triangle: Vec<u32>,
     /// The regions.
     pub regions: Vec<PartitionRegion>,
-    /// For each region, the length of boundary it shares with each neighbouring region.
-    pub shared: Vec<HashMap<u32, f64>>,
+    /// For each region, the length of boundary it shares with each neighbouring region (ordered,
+    /// so that sums over it are the same on every run).
+    pub shared: Vec<BTreeMap<u32, f64>>,
 }
 
 impl PartitionRegions {
@@ -123,7 +124,7 @@ impl PartitionRegions {
             }
             regions.push(region);
         }
-        let mut shared = vec![HashMap::new(); regions.len()];
+        let mut shared = vec![BTreeMap::new(); regions.len()];
         for f in t.triangles() {
             let a = of_triangle[f.index()];
             for e in t.triangle_edges(f) {
@@ -228,7 +229,7 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
                 continue;
             }
             // The neighbour with the longest shared boundary (ties to the lower id).
-            let mut by_root: HashMap<u32, f64> = HashMap::new();
+            let mut by_root: BTreeMap<u32, f64> = BTreeMap::new();
             for (&d, &len) in &shared[r as usize] {
                 let q = root(&mut parent, d);
                 if q != r {

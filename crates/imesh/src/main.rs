@@ -124,10 +124,10 @@ struct MeshFlags {
     /// equilateral one of this side.
     #[arg(long)]
     max_size: Option<f64>,
-    /// Quad size: auto (uniform, at the spacing the simplified boundaries suggest), a side in
-    /// pixels (uniform: a square lattice inside, refined along the boundaries), or graded (the
-    /// paper's: fine at the boundaries, coarse inside; fewer quads, lower shape-and-size)
-    /// [default: auto].
+    /// Quad size: auto (uniform, a side chosen from the image: about 10 000 quads, finer where
+    /// its regions are narrow), a side in pixels (uniform: a square lattice inside, refined
+    /// along the boundaries), or graded (the paper's: fine at the boundaries, coarse inside;
+    /// fewer quads, lower shape-and-size) [default: auto].
     #[arg(long)]
     size: Option<imesh::ElementSize>,
     /// Merge regions smaller than this many pixels into their neighbour before meshing
