@@ -372,6 +372,9 @@ pub struct Counts {
     pub height: u32,
     /// Labels in the label grid.
     pub labels: usize,
+    /// Labels the mesh's elements carry (one physical group each in the written files): fewer
+    /// than `labels` when the clean-up merged every region of a label away.
+    pub meshed_labels: usize,
     /// Pixels whose label the clean-up (`majority`, `min_region`) changed; label agreement is
     /// measured against the image's own labels, so they count against it.
     pub cleaned_pixels: usize,
@@ -933,6 +936,12 @@ impl Pipeline {
             .filter(|e| matches!(e, Element::Quad(_)))
             .count();
         counts.triangles = elements.len() - counts.quads;
+        counts.meshed_labels = {
+            let mut used = labels.clone();
+            used.sort_unstable();
+            used.dedup();
+            used.len()
+        };
         let mesh = SegmentedMeshData {
             vertices,
             elements,
