@@ -89,8 +89,8 @@ pub struct Simplification {
     pub polyline_of: Vec<u32>,
     /// Chords within the tolerance refused because they would have changed the topology.
     pub refused: usize,
-    /// Vertices that Douglas–Peucker kept and the second pass removed (see
-    /// [`MERGE_SPAN`]).
+    /// Vertices that Douglas–Peucker kept and the second pass (see [`MERGE_SPAN`]) or the third
+    /// ([`SimplifyOptions::min_length`]) removed.
     pub merged: usize,
     /// The largest distance from an original vertex to its simplified edge.
     pub max_deviation: f64,

@@ -70,6 +70,26 @@ pub struct SegmentedMeshData {
     pub height: u32,
 }
 
+impl SegmentedMeshData {
+    /// The labels the elements carry, ascending, each once (one physical group each in the
+    /// written files).
+    ///
+    /// ```
+    /// use imesh_io::SegmentedMeshData;
+    /// let mesh = SegmentedMeshData {
+    ///     vertices: vec![], elements: vec![], labels: vec![3, 0, 3, 2],
+    ///     label_names: vec![], label_colours: vec![], width: 1, height: 1,
+    /// };
+    /// assert_eq!(mesh.used_labels(), vec![0, 2, 3]);
+    /// ```
+    pub fn used_labels(&self) -> Vec<u32> {
+        let mut used = self.labels.clone();
+        used.sort_unstable();
+        used.dedup();
+        used
+    }
+}
+
 /// The written frame: y up, scaled by a physical pixel size.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {

@@ -16,12 +16,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut s = String::new();
     // Writing to a String cannot fail; the results are ignored on purpose.
     let _ = writeln!(s, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
-    let used: Vec<u32> = {
-        let mut u = mesh.labels.clone();
-        u.sort_unstable();
-        u.dedup();
-        u
-    };
+    let used = mesh.used_labels();
     let curves = boundaries(mesh);
     let _ = writeln!(s, "$PhysicalNames\n{}", used.len() + curves.len());
     for (i, b) in curves.iter().enumerate() {

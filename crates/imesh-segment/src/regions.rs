@@ -13,8 +13,6 @@ use std::collections::BTreeMap;
 
 use imesh_geom::Triangulation;
 
-use crate::partition::OUTSIDE;
-
 /// "No region" in [`PartitionRegions::of_triangle`] (ghost slots).
 pub const NO_REGION: u32 = u32::MAX;
 
@@ -195,12 +193,11 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
     if min_width.is_nan() || min_width <= 0.0 {
         return report;
     }
-    let found = PartitionRegions::new(t, label);
     let PartitionRegions {
         of_triangle,
         mut regions,
         mut shared,
-    } = found;
+    } = PartitionRegions::new(t, label);
     let n = regions.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn root(parent: &mut [u32], mut r: u32) -> u32 {
@@ -210,12 +207,14 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
         }
         r
     }
-    // Thinnest first; a region's width only grows when others merge into it, so one pass in
-    // this order, re-judging each region when its turn comes, leaves no thin region behind but
-    // those a later merge made thinner (they are collected again below).
-    let mut queue: Vec<u32> = (0..n as u32).collect();
+    // Rounds over the thin regions, thinnest first. A merge changes the target's width either
+    // way (a speck merged into a strip widens it; a strip merged into a compact region may
+    // make it thin), so each region is judged again when its turn comes, and every root again
+    // in the next round.
     loop {
-        queue.retain(|&r| parent[r as usize] == r && regions[r as usize].width() < min_width);
+        let mut queue: Vec<u32> = (0..n as u32)
+            .filter(|&r| parent[r as usize] == r && regions[r as usize].width() < min_width)
+            .collect();
         if queue.is_empty() {
             break;
         }
@@ -262,9 +261,6 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
         if !merged_any {
             break;
         }
-        // Merging may have made a region thinner (a wide region absorbing a long strip): judge
-        // every remaining root again.
-        queue = (0..n as u32).collect();
     }
     if report.regions == 0 {
         return report;
@@ -274,7 +270,7 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
         .collect();
     for (slot, l) in label.iter_mut().enumerate() {
         let r = of_triangle[slot];
-        if r != NO_REGION && *l != OUTSIDE {
+        if r != NO_REGION {
             *l = final_label[r as usize];
         }
     }

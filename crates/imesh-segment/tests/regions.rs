@@ -8,32 +8,26 @@ use proptest::prelude::*;
 /// Random label images with specks, strips and blobs: a few labels on a coarse random grid,
 /// scaled up unevenly so that some regions are one pixel thin and others wide.
 fn label_image() -> impl Strategy<Value = LabelGrid> {
-    (4u32..40, 4u32..40, 1u32..5, any::<u64>()).prop_map(|(w, h, labels, seed)| {
-        let mut state = seed | 1;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        let cells: Vec<u32> = (0..64)
-            .map(|_| (next() % u64::from(labels)) as u32)
-            .collect();
-        let (sx, sy) = (1 + next() % 7, 1 + next() % 7);
-        let grid: Vec<u32> = (0..w * h)
-            .map(|i| {
-                let (x, y) = (u64::from(i % w) / sx, u64::from(i / w) / sy);
-                cells[((y % 8) * 8 + x % 8) as usize]
-            })
-            .collect();
-        let regions = (0..labels)
-            .map(|l| Region {
-                name: format!("l{l}"),
-                colour: [l as u8; 3],
-            })
-            .collect();
-        LabelGrid::new(w, h, grid, regions).unwrap()
-    })
+    (4u32..40, 4u32..40, 1u32..5)
+        .prop_flat_map(|(w, h, labels)| {
+            let cells = prop::collection::vec(0..labels, 64);
+            (Just((w, h, labels)), cells, 1u32..8, 1u32..8)
+        })
+        .prop_map(|((w, h, labels), cells, sx, sy)| {
+            let grid: Vec<u32> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) / sx, (i / w) / sy);
+                    cells[((y % 8) * 8 + x % 8) as usize]
+                })
+                .collect();
+            let regions = (0..labels)
+                .map(|l| Region {
+                    name: format!("l{l}"),
+                    colour: [l as u8; 3],
+                })
+                .collect();
+            LabelGrid::new(w, h, grid, regions).unwrap()
+        })
 }
 
 proptest! {

@@ -82,7 +82,8 @@ pub enum ElementSize {
     Graded,
 }
 
-/// Largest [`MeshOptions::majority`] radius: the filter costs (2R+1)² per pixel.
+/// Largest [`MeshOptions::majority`] radius: the filter costs 2(2R+1) per pixel on label maps
+/// of up to 32 labels, (2R+1)² on others.
 pub const MAX_MAJORITY: u32 = 8;
 
 /// Smallest quad side `--size auto` chooses, in pixels: the Imesh partition's vertices are
@@ -936,12 +937,6 @@ impl Pipeline {
             .filter(|e| matches!(e, Element::Quad(_)))
             .count();
         counts.triangles = elements.len() - counts.quads;
-        counts.meshed_labels = {
-            let mut used = labels.clone();
-            used.sort_unstable();
-            used.dedup();
-            used.len()
-        };
         let mesh = SegmentedMeshData {
             vertices,
             elements,
@@ -951,28 +946,11 @@ impl Pipeline {
             width: w,
             height: h,
         };
-        // Against the image's own labels, so that the clean-up's changes count as disagreement
-        // (the cleaned grid may number its labels differently: match them by name).
-        let label_agreement = if cleaned.is_some() {
-            let id: std::collections::HashMap<&str, u32> = original
-                .regions()
-                .iter()
-                .enumerate()
-                .map(|(i, r)| (r.name.as_str(), i as u32))
-                .collect();
-            let labels: Vec<u32> = mesh
-                .labels
-                .iter()
-                .map(|&l| {
-                    grid.regions()
-                        .get(l as usize)
-                        .and_then(|r| id.get(r.name.as_str()).copied())
-                        .unwrap_or(u32::MAX)
-                })
-                .collect();
-            agreement(&mesh.vertices, &mesh.elements, &labels, original)
-        } else {
-            label_agreement(&mesh, grid)
+        counts.meshed_labels = mesh.used_labels().len();
+        // Against the image's own labels, so that the clean-up's changes count as disagreement.
+        let label_agreement = match &cleaned {
+            Some(_) => agreement_with_original(&mesh, grid, original),
+            None => label_agreement(&mesh, grid),
         };
         seconds.check = check.elapsed().as_secs_f64();
         seconds.total = classified + start.elapsed().as_secs_f64();
@@ -1314,11 +1292,10 @@ impl Pipeline {
                 o.template_level
             )));
         }
-        if o.majority.is_some_and(|r| r > MAX_MAJORITY) {
+        if let Some(r) = o.majority.filter(|&r| r > MAX_MAJORITY) {
             return Err(PipelineError::Options(format!(
-                "the majority filter radius {} is too large: give 0 to {MAX_MAJORITY} pixels \
-                 (use --min-region for larger specks)",
-                o.majority.unwrap_or_default()
+                "the majority filter radius {r} is too large: give 0 to {MAX_MAJORITY} pixels \
+                 (use --min-region for larger specks)"
             )));
         }
         if let Some(w) = o.min_width.filter(|w| !(w.is_finite() && *w >= 0.0)) {
@@ -1356,10 +1333,6 @@ impl Pipeline {
 /// Vertices, elements and labels of a mesh.
 type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
 
-/// The boundary graph G of an Imesh partition: its c-edges, with the domain corners pinned (the
-/// curve stage's input).
-///
-/// # Errors
 /// The radius of the majority filter that `--majority auto` applies before a uniform mesh of
 /// quad side `quad_size`: about one quad, so that notches, specks and strips the quads could
 /// only follow with small elements are smoothed away (1 to [`MAX_MAJORITY`] pixels).
@@ -1409,6 +1382,10 @@ pub fn boundary_weighted_width(
     by_width.last().map_or(0.0, |&(w, _)| w)
 }
 
+/// The boundary graph G of an Imesh partition: its c-edges, with the domain corners pinned (the
+/// curve stage's input).
+///
+/// # Errors
 /// [`imesh_curves::CurveError`] if the c-edges do not make a valid graph (a bug in the sampler).
 pub fn boundary_graph(segmented: &SegmentedMesh) -> Result<CurveGraph, imesh_curves::CurveError> {
     let edges = segmented
@@ -1437,6 +1414,33 @@ fn equilateral_area(s: f64) -> f64 {
 /// so a centre is inside when it is on the inner side of every edge.
 pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
     agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid)
+}
+
+/// [`label_agreement`] of a mesh labelled by the `cleaned` grid, against the `original` one it was
+/// cleaned from (which may number its labels differently: they are matched by name).
+fn agreement_with_original(
+    mesh: &SegmentedMeshData,
+    cleaned: &LabelGrid,
+    original: &LabelGrid,
+) -> f64 {
+    let id: std::collections::HashMap<&str, u32> = original
+        .regions()
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (r.name.as_str(), i as u32))
+        .collect();
+    let labels: Vec<u32> = mesh
+        .labels
+        .iter()
+        .map(|&l| {
+            cleaned
+                .regions()
+                .get(l as usize)
+                .and_then(|r| id.get(r.name.as_str()).copied())
+                .unwrap_or(u32::MAX)
+        })
+        .collect();
+    agreement(&mesh.vertices, &mesh.elements, &labels, original)
 }
 
 /// [`label_agreement`] of elements with their own labels (numbered as `grid`'s).
