@@ -7,6 +7,8 @@
 //!   [`faces`](CurveGraph::faces) and a planarity check;
 //! - [`polylines`]: the maximal simple open polylines, cut at vertices of valence ≠ 2, at pinned
 //!   vertices (the domain corners) and every closed loop into three pieces;
+//! - [`contract_short_links`]: junctions that a boundary much shorter than the elements joins
+//!   (four regions meeting at a pixel corner) merged into one;
 //! - [`simplify`]: topology-preserving Douglas–Peucker, giving the PSLG G' whose every edge
 //!   remembers the chain of original vertices it replaces;
 //! - [`CubicBezier`] and [`fit_cubic`]: de Casteljau evaluation and exact splitting, and the
@@ -30,6 +32,7 @@
 //! ```
 
 mod bezier;
+mod contract;
 mod distance;
 mod faces;
 mod graph;
@@ -40,6 +43,7 @@ mod simplify;
 use rayon::prelude::*;
 
 pub use bezier::{fit_cubic, fit_cubic_at, CubicBezier, CurveFit, FitOptions};
+pub use contract::{contract_short_links, Contraction};
 pub use distance::{segment_distance, segment_distance_squared, segment_parameter};
 pub use graph::{CurveGraph, Face, GraphEdge};
 pub use grid::SegmentIndex;

@@ -599,7 +599,7 @@ fn straight(points: &[Point], chain: &[u32]) -> bool {
 }
 
 /// The vertices of each grid cell that some edge ends at, with their points.
-fn vertex_cells(g: &CurveGraph, grid: &Grid) -> CellLists<(u32, Point)> {
+pub(crate) fn vertex_cells(g: &CurveGraph, grid: &Grid) -> CellLists<(u32, Point)> {
     let pairs: Vec<(u32, (u32, Point))> = (0..g.points().len() as u32)
         .filter(|&v| g.valence(v) > 0)
         .map(|v| (grid.cell(g.point(v)) as u32, (v, g.point(v))))
@@ -625,7 +625,7 @@ fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
 /// True when `p` lies on the closed curve `chain + chord` (chain closed back to its start) or the
 /// curve winds around it. Exact: winding number by upward/downward crossings decided with
 /// `orient2d`.
-fn encloses(points: &[Point], chain: &[u32], p: Point) -> bool {
+pub(crate) fn encloses(points: &[Point], chain: &[u32], p: Point) -> bool {
     let mut winding = 0i64;
     let closing = [chain[chain.len() - 1], chain[0]];
     let edges = chain

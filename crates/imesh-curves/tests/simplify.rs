@@ -3,8 +3,8 @@
 mod support;
 
 use imesh_curves::{
-    fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph, FitOptions,
-    GraphEdge, SegmentIndex, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
+    contract_short_links, fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph,
+    FitOptions, GraphEdge, SegmentIndex, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -169,6 +169,61 @@ proptest! {
             check_simplification(&g, &s, tolerance);
         }
     }
+}
+
+/// A contracted graph is a valid boundary graph: planar, every face of one label and of some
+/// area, the domain corners where they were, each edge one of the input's (with its ends
+/// merged), and simplification keeps its topology as it does any other's.
+fn check_contraction(g: &CurveGraph, min_length: f64, w: u32, h: u32) -> usize {
+    let c =
+        contract_short_links(g, min_length, DEFAULT_TOLERANCE, f64::from(w), f64::from(h)).unwrap();
+    assert_eq!(c.graph.crossing(), None, "contracted edges cross");
+    for f in c.graph.faces() {
+        assert!(f.consistent, "a contracted face has two labels");
+        assert!(f.area != 0.0, "a contracted face has no area");
+    }
+    if c.contracted == 0 {
+        assert_eq!(c.graph.edges(), g.edges());
+    } else {
+        assert!(c.graph.edges().len() < g.edges().len());
+    }
+    for v in 0..g.points().len() as u32 {
+        if g.is_pinned(v) && g.valence(v) > 0 {
+            assert_eq!(c.graph.point(v), g.point(v), "a pinned vertex moved");
+            assert!(c.graph.valence(v) > 0 && c.graph.is_pinned(v));
+        }
+    }
+    let labels: std::collections::HashSet<[u32; 2]> = g.edges().iter().map(|e| e.labels).collect();
+    assert!(c.graph.edges().iter().all(|e| labels.contains(&e.labels)));
+    let s = simplify(
+        &c.graph,
+        &SimplifyOptions::with_tolerance(DEFAULT_TOLERANCE),
+    )
+    .unwrap();
+    check_simplification(&c.graph, &s, DEFAULT_TOLERANCE);
+    c.contracted
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn contracting_short_links_keeps_a_valid_graph(
+        (w, h, labels) in label_image(), min_length in 0.5f64..4.0,
+    ) {
+        let g = support::imesh_boundaries(&support::grid(w, h, labels));
+        check_contraction(&g, min_length, w, h);
+    }
+}
+
+/// Four labels meeting at pixel corners: the stardist fixture has such places, and each
+/// contraction there leaves a valid graph.
+#[test]
+fn links_between_junctions_at_pixel_corners_are_contracted() {
+    let grid = support::fixture("stardist-mask2d_labels.png");
+    let g = support::imesh_boundaries(&grid);
+    let contracted = check_contraction(&g, 2.0, grid.width(), grid.height());
+    assert!(contracted >= 1, "{contracted} links contracted");
 }
 
 fn edge(a: u32, b: u32, labels: [u32; 2]) -> GraphEdge {

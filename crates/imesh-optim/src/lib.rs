@@ -50,6 +50,7 @@ mod global;
 mod laplacian;
 mod local;
 mod powell;
+mod slide;
 mod variables;
 
 pub use energy::{is_valid, Metric};
@@ -121,6 +122,12 @@ pub struct OptimOptions {
     /// the inside is settled from the start, and solving it gains next to nothing (measured:
     /// mean shape-and-size within 0.004, 20–45 % less optimiser time). 1 solves every point.
     pub settled: f64,
+    /// After the local mode's control points: the quad vertices on every boundary curve slide
+    /// along it (between their neighbours there, staying on the curve), then every free quad
+    /// vertex is moved once more as in the vertex mode, so that the inside follows. The
+    /// control points keep the spacing DT' gave each boundary; this frees it. Measured on the
+    /// fixtures: mean shape-and-size +0.004 to +0.038, optimiser time +20–30 %.
+    pub slide: bool,
 }
 
 impl Default for OptimOptions {
@@ -135,6 +142,7 @@ impl Default for OptimOptions {
             global_iterations: 20,
             keep_shape: 0.5,
             settled: 0.95,
+            slide: true,
         }
     }
 }
@@ -170,8 +178,11 @@ pub struct OptimReport {
     pub energy_before: f64,
     /// Energy after.
     pub energy_after: f64,
-    /// Sweeps (local modes) or Powell iterations (global).
+    /// Sweeps (local modes, the sliding and its vertex pass included) or Powell iterations
+    /// (global).
     pub sweeps: usize,
+    /// Quad vertices that slid along the boundary curves ([`OptimOptions::slide`]).
+    pub sliders: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
     /// Quality before.
@@ -316,6 +327,12 @@ fn quality(vertices: &[Point], quads: &[[u32; 4]]) -> QuadQuality {
 /// [`OptimError::Solver`] if argmin fails in the global mode.
 pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimReport, OptimError> {
     let clock = Instant::now();
+    let mut sliders = if options.slide && options.method == Method::Local {
+        slide::Sliders::new(remesh)
+    } else {
+        slide::Sliders::default()
+    };
+    let mut slid = 0;
     let Remesh {
         dt,
         elements,
@@ -390,6 +407,27 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                 setup,
                 |v| setup.energy(v),
             );
+            let sweeps = if options.slide {
+                // The boundary vertices slide along their curves, and the inside follows.
+                // Moving quad vertices directly, a quad of good shape can lose a corner's
+                // angle that the control points' smoothness kept: here every quad is held to
+                // the start's worst scaled Jacobian.
+                slid = sliders.len();
+                let worst = before.scaled_jacobian.min;
+                let held: Vec<f64> = jacobian_floors.iter().map(|&f| f.max(worst)).collect();
+                let polish = Setup {
+                    jacobian_floors: &held,
+                    ..setup
+                };
+                let vertex_vars = Variables::vertices(t, elements, mesh);
+                sweeps
+                    + sliders.sweep(&mut mesh.vertices, &polish, options.max_sweeps)
+                    + local::descend(&vertex_vars, &mut mesh.vertices, None, polish, |v| {
+                        polish.energy(v)
+                    })
+            } else {
+                sweeps
+            };
             (vars.len(), vars.colours.len(), sweeps)
         }
         Method::Global => {
@@ -416,6 +454,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         energy_before,
         energy_after,
         sweeps,
+        sliders: slid,
         seconds: clock.elapsed().as_secs_f64(),
         before,
         after,

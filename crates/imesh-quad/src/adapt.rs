@@ -42,6 +42,26 @@ pub struct EdgeCurve {
     pub weight: f64,
 }
 
+impl EdgeCurve {
+    /// The piece as the mesh has it: the curve piece blended with the straight piece between
+    /// the same DT' vertices by [`EdgeCurve::weight`], from the M edge's origin (parameter 0)
+    /// to its destination (1). The edge's template points lie on it.
+    ///
+    /// ```
+    /// use imesh_curves::CubicBezier;
+    /// use imesh_geom::Point;
+    /// use imesh_quad::EdgeCurve;
+    /// let (a, b) = (Point::new(0.0, 0.0), Point::new(3.0, 0.0));
+    /// let curve = CubicBezier::new([a, Point::new(1.0, 3.0), Point::new(2.0, 3.0), b]);
+    /// let ec = EdgeCurve { edge: 0, graph_edge: 0, parameters: [0.0, 1.0], curve, chord: [a, b], weight: 0.5 };
+    /// // Half the bulge: the curve's midpoint is 2.25 above the chord, the path's 1.125.
+    /// assert_eq!(ec.path().eval(0.5), Point::new(1.5, 1.125));
+    /// ```
+    pub fn path(&self) -> CubicBezier {
+        CubicBezier::new(blend(self))
+    }
+}
+
 /// A quad that adaptation leaves with a scaled Jacobian below both this and its straight value
 /// is repaired like an inverted one: the curve costs the element more than it is worth.
 pub const POOR_SCALED_JACOBIAN: f64 = 0.2;

@@ -23,7 +23,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
-use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
+use imesh_curves::{
+    contract_short_links, fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions,
+};
 use imesh_geom::{RefineOptions, StopReason};
 use imesh_io::SegmentedMeshData;
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
@@ -100,6 +102,12 @@ pub const AUTO_WIDTH_SHARE: f64 = 0.35;
 /// Boundary pieces shorter than this many quad sides are joined with a neighbour where the
 /// topology and a deviation of half their length allow ([`SimplifyOptions::min_length`]).
 pub const MIN_PIECE: f64 = 1.0;
+
+/// Two junctions of the boundaries closer than this many quad sides, joined by a boundary
+/// within the curve tolerance of the segment between them, are merged into one
+/// ([`contract_short_links`]): where four regions meet at a pixel corner, Imesh gives two
+/// junctions a fraction of a pixel apart, and the quads around such a link are that small.
+pub const LINK_SHARE: f64 = 0.5;
 
 /// The automatic [`MeshOptions::min_width`], as a share of the quad size: a region thinner than
 /// half a quad can only be filled with quads of a fraction of the mean area.
@@ -385,6 +393,8 @@ pub struct Counts {
     pub merged_regions: usize,
     /// Their area in square pixels.
     pub merged_area: f64,
+    /// Pairs of boundary junctions merged for being closer than [`LINK_SHARE`] quad sides.
+    pub contracted_links: usize,
     /// The side of the quads of a uniform mesh, in pixels (0 when graded or for triangles).
     pub quad_size: f64,
     /// c-edges of the partition.
@@ -1036,6 +1046,22 @@ impl Pipeline {
         let start = Instant::now();
         self.stage(Stage::Curves);
         let g = boundary_graph(segmented)?;
+        let g = match quad_size {
+            // Junctions closer than a fraction of a quad (four regions meeting at a pixel
+            // corner) would pin a boundary piece that short, and quads that small around it.
+            Some(q) => {
+                let c = contract_short_links(
+                    &g,
+                    LINK_SHARE * q,
+                    o.tolerance,
+                    f64::from(segmented.width),
+                    f64::from(segmented.height),
+                )?;
+                counts.contracted_links = c.contracted;
+                c.graph
+            }
+            None => g,
+        };
         let simplified = simplify(
             &g,
             &SimplifyOptions {

@@ -1,0 +1,264 @@
+//! Boundary vertices sliding along their curves: the quad vertices on a G' edge, between its
+//! two G' vertices, each moved along the edge's curve (one variable, its position along the
+//! curve) to lower the energy of its quads.
+//!
+//! The control-point modes keep every c-edge's control points, so a quad along a boundary
+//! keeps the spacing DT' gave its boundary vertices; but any spacing of points on the curve
+//! follows the boundary equally well. Moving a vertex along the curve keeps it exactly on the
+//! curve and changes only where, between its neighbours on the same curve, it sits.
+
+use imesh_curves::CubicBezier;
+use imesh_geom::Point;
+use imesh_quad::Remesh;
+use rayon::prelude::*;
+
+use crate::Setup;
+
+/// One G' edge's boundary path: the pieces (M edges) in order along it, and the quad vertices
+/// on it; vertex `j` sits at `along[j]` (piece `⌊along⌋`, parameter `along − ⌊along⌋` on it).
+#[derive(Clone, Debug)]
+struct Chain {
+    pieces: Vec<CubicBezier>,
+    vertices: Vec<u32>,
+}
+
+impl Chain {
+    fn point(&self, along: f64) -> Point {
+        let last = self.pieces.len() - 1;
+        let p = (along.floor() as usize).min(last);
+        self.pieces[p].eval(along - p as f64)
+    }
+}
+
+/// The sliding vertices of a mesh.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Sliders {
+    chains: Vec<Chain>,
+    /// Per slider: its chain and its index there (never the first or the last).
+    slot: Vec<(u32, u32)>,
+    /// Per chain, the position of each vertex along it.
+    along: Vec<Vec<f64>>,
+    /// Per slider, the quads around its vertex.
+    quads: Vec<Vec<u32>>,
+    /// Sliders by colour: two of one colour share no quad (so neither bounds the other).
+    colours: Vec<Vec<u32>>,
+}
+
+/// A vertex the template put at parameter `s` of its piece must be there to within this
+/// (relative to the piece's size), or its chain is left alone.
+const ON_PATH: f64 = 1e-9;
+
+impl Sliders {
+    /// The boundary vertices of `remesh`'s quad mesh, from its adapted M edges: each G' edge's
+    /// pieces sorted along its curve, their template points at `i / 2k`.
+    pub fn new(remesh: &Remesh) -> Self {
+        let Remesh {
+            dt,
+            elements,
+            mesh,
+            edge_curves,
+            ..
+        } = remesh;
+        let t = &dt.triangulation;
+        let per_edge = 2 * mesh.level() as usize;
+        let mut by_graph_edge: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+        for (i, ec) in edge_curves.iter().enumerate() {
+            by_graph_edge.entry(ec.graph_edge).or_default().push(i);
+        }
+        let mut chains = Vec::new();
+        for (_, mut list) in by_graph_edge {
+            let lo = |i: &usize| edge_curves[*i].parameters[0].min(edge_curves[*i].parameters[1]);
+            list.sort_by(|a, b| lo(a).total_cmp(&lo(b)));
+            let mut chain = Chain {
+                pieces: Vec::new(),
+                vertices: Vec::new(),
+            };
+            for i in list {
+                let ec = &edge_curves[i];
+                let mut vertices = mesh.edge_vertices(t, elements, ec.edge);
+                let mut path = ec.path();
+                if ec.parameters[0] > ec.parameters[1] {
+                    vertices.reverse();
+                    let c = path.control;
+                    path = CubicBezier::new([c[3], c[2], c[1], c[0]]);
+                }
+                let size = path.control[0].distance_squared(path.control[3]).sqrt();
+                let on_path = vertices.iter().enumerate().all(|(k, &v)| {
+                    let s = k as f64 / per_edge as f64;
+                    path.eval(s)
+                        .distance_squared(mesh.vertices[v as usize])
+                        .sqrt()
+                        <= ON_PATH * (1.0 + size)
+                });
+                let continues = chain.vertices.last().is_none_or(|&v| v == vertices[0]);
+                if !on_path || !continues {
+                    // A gap or a piece off its path: what came before is a chain of its own.
+                    chains.push(std::mem::replace(
+                        &mut chain,
+                        Chain {
+                            pieces: Vec::new(),
+                            vertices: Vec::new(),
+                        },
+                    ));
+                    if !on_path {
+                        continue;
+                    }
+                }
+                if chain.vertices.is_empty() {
+                    chain.vertices.push(vertices[0]);
+                }
+                chain.vertices.extend_from_slice(&vertices[1..]);
+                chain.pieces.push(path);
+            }
+            chains.push(chain);
+        }
+        chains.retain(|c| c.vertices.len() >= 3);
+        let along: Vec<Vec<f64>> = chains
+            .iter()
+            .map(|c| {
+                (0..c.vertices.len())
+                    .map(|j| j as f64 / per_edge as f64)
+                    .collect()
+            })
+            .collect();
+        let mut around = vec![Vec::new(); mesh.vertices.len()];
+        for (q, quad) in mesh.quads.iter().enumerate() {
+            for &v in quad {
+                around[v as usize].push(q as u32);
+            }
+        }
+        let mut slot = Vec::new();
+        let mut quads = Vec::new();
+        for (c, chain) in chains.iter().enumerate() {
+            for j in 1..chain.vertices.len() - 1 {
+                slot.push((c as u32, j as u32));
+                quads.push(around[chain.vertices[j] as usize].clone());
+            }
+        }
+        let colours = colour(&quads, mesh.quads.len());
+        Self {
+            chains,
+            slot,
+            along,
+            quads,
+            colours,
+        }
+    }
+
+    /// Number of sliding vertices.
+    pub fn len(&self) -> usize {
+        self.slot.len()
+    }
+
+    /// Sweeps over the sliders, colour by colour, until a sweep lowers the energy of the quads
+    /// they move by less than `setup.tolerance` of it, or `sweeps` of them. Returns the sweeps.
+    pub fn sweep(&mut self, vertices: &mut [Point], setup: &Setup<'_>, sweeps: usize) -> usize {
+        let mut done = 0;
+        for _ in 0..sweeps {
+            done += 1;
+            let mut gained = 0.0;
+            let mut total = 0.0;
+            for colour in &self.colours {
+                let moves: Vec<(u32, f64, Point, f64, f64)> = colour
+                    .par_iter()
+                    .filter_map(|&i| self.solve(i as usize, vertices, setup))
+                    .collect();
+                for (i, along, p, before, after) in moves {
+                    let (c, j) = self.slot[i as usize];
+                    self.along[c as usize][j as usize] = along;
+                    vertices[self.chains[c as usize].vertices[j as usize] as usize] = p;
+                    gained += before - after;
+                    total += before;
+                }
+            }
+            if total <= 0.0 || gained <= setup.tolerance * total {
+                break;
+            }
+        }
+        done
+    }
+
+    /// The best position of slider `i` between its neighbours: golden-section search of the
+    /// energy of its quads, from where it is. `None` when it cannot improve.
+    fn solve(
+        &self,
+        i: usize,
+        vertices: &[Point],
+        setup: &Setup<'_>,
+    ) -> Option<(u32, f64, Point, f64, f64)> {
+        let (c, j) = self.slot[i];
+        let (chain, along) = (&self.chains[c as usize], &self.along[c as usize]);
+        let v = chain.vertices[j as usize];
+        let (lo, hi) = (along[j as usize - 1], along[j as usize + 1]);
+        // Stay clear of the neighbours: a vertex on top of one would make a degenerate quad.
+        let margin = 0.05 * (hi - lo);
+        let (lo, hi) = (lo + margin, hi - margin);
+        let energy = |a: f64| -> f64 {
+            let p = chain.point(a);
+            let mut sum = 0.0;
+            for &q in &self.quads[i] {
+                let corners =
+                    setup.quads[q as usize].map(|u| if u == v { p } else { vertices[u as usize] });
+                match setup.term(q as usize, &corners) {
+                    Some(e) => sum += e,
+                    None => return f64::INFINITY,
+                }
+            }
+            sum
+        };
+        let start = along[j as usize];
+        let before = energy(start);
+        if !before.is_finite() || before <= setup.settled_term * self.quads[i].len() as f64 {
+            return None;
+        }
+        // Golden section on [lo, hi]; the start is kept as the best until beaten.
+        let ratio = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut a, mut b) = (lo, hi);
+        let mut x1 = b - ratio * (b - a);
+        let mut x2 = a + ratio * (b - a);
+        let (mut f1, mut f2) = (energy(x1), energy(x2));
+        for _ in 0..GOLDEN_STEPS {
+            if f1 <= f2 {
+                b = x2;
+                (x2, f2) = (x1, f1);
+                x1 = b - ratio * (b - a);
+                f1 = energy(x1);
+            } else {
+                a = x1;
+                (x1, f1) = (x2, f2);
+                x2 = a + ratio * (b - a);
+                f2 = energy(x2);
+            }
+        }
+        let (best, after) = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
+        (after < before).then(|| (i as u32, best, chain.point(best), before, after))
+    }
+}
+
+/// Golden-section steps per solve: the bracket shrinks to 0.618²⁰ ≈ 10⁻⁴ of the gap between
+/// the neighbours.
+const GOLDEN_STEPS: usize = 20;
+
+/// Greedy colouring: each slider takes the smallest colour no earlier slider sharing one of its
+/// quads has.
+fn colour(quads: &[Vec<u32>], n_quads: usize) -> Vec<Vec<u32>> {
+    let mut by_quad: Vec<Vec<u32>> = vec![Vec::new(); n_quads];
+    let mut colour_of = vec![usize::MAX; quads.len()];
+    let mut colours: Vec<Vec<u32>> = Vec::new();
+    for (i, qs) in quads.iter().enumerate() {
+        let taken: Vec<usize> = qs
+            .iter()
+            .flat_map(|&q| by_quad[q as usize].iter().map(|&j| colour_of[j as usize]))
+            .collect();
+        let c = (0..).find(|c| !taken.contains(c)).unwrap_or(0);
+        colour_of[i] = c;
+        if colours.len() <= c {
+            colours.resize(c + 1, Vec::new());
+        }
+        colours[c].push(i as u32);
+        for &q in qs {
+            by_quad[q as usize].push(i as u32);
+        }
+    }
+    colours
+}
