@@ -150,6 +150,29 @@ impl Sliders {
         self.slot.len()
     }
 
+    /// Per quad vertex of a mesh of `n` vertices (quads `quads`): true within `rings` quad
+    /// rings of a sliding vertex (0: the sliding vertices themselves).
+    pub fn near(&self, quads: &[[u32; 4]], n: usize, rings: usize) -> Vec<bool> {
+        let mut near = vec![false; n];
+        for &(c, j) in &self.slot {
+            near[self.chains[c as usize].vertices[j as usize] as usize] = true;
+        }
+        for _ in 0..rings {
+            let grown: Vec<bool> = quads
+                .iter()
+                .map(|q| q.iter().any(|&v| near[v as usize]))
+                .collect();
+            for (q, &g) in quads.iter().zip(&grown) {
+                if g {
+                    for &v in q {
+                        near[v as usize] = true;
+                    }
+                }
+            }
+        }
+        near
+    }
+
     /// Sweeps over the sliders, colour by colour, until a sweep lowers the energy of the quads
     /// they move by less than `setup.tolerance` of it, or `sweeps` of them. Returns the sweeps.
     pub fn sweep(&mut self, vertices: &mut [Point], setup: &Setup<'_>, sweeps: usize) -> usize {

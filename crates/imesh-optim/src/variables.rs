@@ -191,6 +191,16 @@ impl Variables {
 
     /// The free quad vertices: all but those on constrained M edges (vertex mode).
     pub fn vertices(t: &Triangulation, m: &ElementMesh, mesh: &QuadMesh) -> Self {
+        Self::vertices_where(t, m, mesh, |_| true)
+    }
+
+    /// The free quad vertices for which `wanted` holds.
+    pub fn vertices_where(
+        t: &Triangulation,
+        m: &ElementMesh,
+        mesh: &QuadMesh,
+        wanted: impl Fn(u32) -> bool,
+    ) -> Self {
         let mut fixed = vec![false; mesh.vertices.len()];
         for (e, &c) in constrained_edges(t, m).iter().enumerate() {
             if c {
@@ -200,7 +210,7 @@ impl Variables {
             }
         }
         let ids: Vec<u32> = (0..mesh.vertices.len() as u32)
-            .filter(|&v| !fixed[v as usize])
+            .filter(|&v| !fixed[v as usize] && wanted(v))
             .collect();
         let influence = ids.iter().map(|&v| vec![(v, 1.0)]).collect();
         let ring = vec![Vec::new(); ids.len()];
