@@ -133,7 +133,7 @@ pub struct OptimOptions {
     /// the inside is settled from the start, and solving it gains next to nothing (measured:
     /// mean shape-and-size within 0.004, 20–45 % less optimiser time). 1 solves every point.
     pub settled: f64,
-    /// After the local mode's control points: the quad vertices on every boundary curve slide
+    /// After the local or the vertex mode: the quad vertices on every boundary curve slide
     /// along it (between their neighbours there, staying on the curve), then the free quad
     /// vertices within [`POLISH_RINGS`] quad rings of them are moved once more as in the vertex
     /// mode, so that the inside follows. The control points keep the spacing DT' gave each
@@ -338,7 +338,8 @@ fn quality(vertices: &[Point], quads: &[[u32; 4]]) -> QuadQuality {
 /// [`OptimError::Solver`] if argmin fails in the global mode.
 pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimReport, OptimError> {
     let clock = Instant::now();
-    let mut sliders = if options.slide && options.method == Method::Local {
+    let sliding = options.slide && matches!(options.method, Method::Local | Method::Vertex);
+    let mut sliders = if sliding {
         slide::Sliders::new(remesh)
     } else {
         slide::Sliders::default()
@@ -418,30 +419,6 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                 setup,
                 |v| setup.energy(v),
             );
-            let sweeps = if options.slide {
-                // The boundary vertices slide along their curves, and the inside follows.
-                // Moving quad vertices directly, a quad of good shape can lose a corner's
-                // angle that the control points' smoothness kept: here every quad is held to
-                // the start's worst scaled Jacobian.
-                slid = sliders.len();
-                let worst = before.scaled_jacobian.min;
-                let held: Vec<f64> = jacobian_floors.iter().map(|&f| f.max(worst)).collect();
-                let polish = Setup {
-                    jacobian_floors: &held,
-                    max_sweeps: POLISH_SWEEPS,
-                    ..setup
-                };
-                let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
-                let vertex_vars =
-                    Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
-                sweeps
-                    + sliders.sweep(&mut mesh.vertices, &polish, options.max_sweeps)
-                    + local::descend(&vertex_vars, &mut mesh.vertices, None, polish, |v| {
-                        polish.energy(v)
-                    })
-            } else {
-                sweeps
-            };
             (vars.len(), vars.colours.len(), sweeps)
         }
         Method::Global => {
@@ -456,6 +433,28 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             .map_err(|e| OptimError::Solver(e.to_string()))?;
             (vars.len(), 0, iterations)
         }
+    };
+    let sweeps = if sliding {
+        // The boundary vertices slide along their curves, and the inside follows. Moving quad
+        // vertices directly, a quad of good shape can lose a corner's angle that the control
+        // points' smoothness kept: here every quad is held to the start's worst scaled Jacobian.
+        slid = sliders.len();
+        let worst = before.scaled_jacobian.min;
+        let held: Vec<f64> = jacobian_floors.iter().map(|&f| f.max(worst)).collect();
+        let polish = Setup {
+            jacobian_floors: &held,
+            max_sweeps: POLISH_SWEEPS,
+            ..setup
+        };
+        let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
+        let vertex_vars = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
+        sweeps
+            + sliders.sweep(&mut mesh.vertices, &polish, options.max_sweeps)
+            + local::descend(&vertex_vars, &mut mesh.vertices, None, polish, |v| {
+                polish.energy(v)
+            })
+    } else {
+        sweeps
     };
     let energy_after = setup.energy(&mesh.vertices);
     let after = quality(&mesh.vertices, &mesh.quads);

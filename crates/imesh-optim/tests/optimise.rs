@@ -122,7 +122,7 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
         assert!(r.mesh.is_valid(q), "{method:?}: quad {q} invalid");
     }
     let (controls, vertices) = constrained(start);
-    let sliding = method == Method::Local && options.slide;
+    let sliding = matches!(method, Method::Local | Method::Vertex) && options.slide;
     for v in vertices {
         let (was, is) = (start.mesh.vertices[v], r.mesh.vertices[v]);
         if sliding && is != was {
