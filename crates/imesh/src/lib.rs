@@ -484,6 +484,8 @@ pub struct Optimisation {
     pub energy_after: f64,
     /// Sweeps (local modes) or Powell iterations (global).
     pub sweeps: usize,
+    /// Quad vertices that slid along the boundary curves after the local or vertex mode.
+    pub sliders: usize,
 }
 
 /// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
@@ -1211,6 +1213,7 @@ impl Pipeline {
                 energy_before: optimisation.energy_before,
                 energy_after: optimisation.energy_after,
                 sweeps: optimisation.sweeps,
+                sliders: optimisation.sliders,
             },
             before: optimisation.before,
             histograms: QualityHistograms {

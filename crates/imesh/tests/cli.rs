@@ -251,6 +251,8 @@ fn the_triangle_mesh_and_quad_options() {
     let energy = |r: &serde_json::Value, key: &str| r["optimisation"][key].as_f64().unwrap();
     assert_eq!(matching["optimisation"]["method"], "local");
     assert!(energy(&matching, "energy_after") < energy(&matching, "energy_before"));
+    // ... and slides the boundary vertices along their curves.
+    assert!(matching["optimisation"]["sliders"].as_u64().unwrap() > 0);
     let stat = |r: &serde_json::Value, block: &str, metric: &str, s: &str| {
         r[block][metric][s].as_f64().unwrap()
     };
