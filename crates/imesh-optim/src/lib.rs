@@ -114,7 +114,9 @@ pub struct OptimOptions {
     pub method: Method,
     /// The quality the energy is built on.
     pub metric: Metric,
-    /// Sweeps stop when one lowers the energy by less than this fraction.
+    /// Sweeps stop when one lowers the energy by less than this fraction (default 3 %: measured
+    /// against 1 %, the local mode takes 9 sweeps instead of 12, 10–45 % less time, for a mean
+    /// shape-and-size 0.0004–0.003 lower; at 10 %, 5 sweeps and 0.002–0.014 lower).
     pub tolerance: f64,
     /// Most sweeps (local, vertex and Laplacian modes).
     pub max_sweeps: usize,
@@ -146,7 +148,7 @@ impl Default for OptimOptions {
         Self {
             method: Method::Local,
             metric: Metric::ShapeAndSize,
-            tolerance: 1e-2,
+            tolerance: 3e-2,
             max_sweeps: 40,
             local_solver: LocalSolver::Powell,
             local_iterations: 1,
