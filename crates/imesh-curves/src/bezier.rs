@@ -36,6 +36,20 @@ impl CubicBezier {
         Self::new([a, a + (b - a) * (1.0 / 3.0), a + (b - a) * (2.0 / 3.0), b])
     }
 
+    /// The same curve run the other way: `reversed().eval(t) == eval(1 − t)`.
+    ///
+    /// ```
+    /// use imesh_curves::CubicBezier;
+    /// use imesh_geom::Point;
+    /// let c = CubicBezier::new([Point::new(0.0, 0.0), Point::new(1.0, 2.0), Point::new(3.0, 2.0), Point::new(4.0, 0.0)]);
+    /// assert_eq!(c.reversed().control[0], Point::new(4.0, 0.0));
+    /// assert!(c.reversed().eval(0.25).distance_squared(c.eval(0.75)) < 1e-24);
+    /// ```
+    pub fn reversed(&self) -> Self {
+        let c = self.control;
+        Self::new([c[3], c[2], c[1], c[0]])
+    }
+
     /// The point at parameter `t`, by de Casteljau's algorithm (stable for any `t`).
     pub fn eval(&self, t: f64) -> Point {
         self.casteljau(t).0

@@ -104,8 +104,7 @@ impl BadQueue {
             ((key as f32).to_bits() >> 19) as usize
         } else {
             BUCKETS - 1
-        }
-        .min(BUCKETS - 1);
+        };
         self.stacks[bucket].push(bad);
         self.full[bucket / 64] |= 1 << (bucket % 64);
         self.summary |= 1 << (bucket / 64);

@@ -346,7 +346,6 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     } else {
         slide::Sliders::default()
     };
-    let mut slid = 0;
     let Remesh {
         dt,
         elements,
@@ -440,7 +439,6 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         // The boundary vertices slide along their curves, and the inside follows. Moving quad
         // vertices directly, a quad of good shape can lose a corner's angle that the control
         // points' smoothness kept: here every quad is held to the start's worst scaled Jacobian.
-        slid = sliders.len();
         let worst = before.scaled_jacobian.min;
         let held: Vec<f64> = jacobian_floors.iter().map(|&f| f.max(worst)).collect();
         let polish = Setup {
@@ -469,7 +467,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         energy_before,
         energy_after,
         sweeps,
-        sliders: slid,
+        sliders: sliders.len(),
         seconds: clock.elapsed().as_secs_f64(),
         before,
         after,

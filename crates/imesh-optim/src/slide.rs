@@ -12,11 +12,12 @@ use imesh_geom::Point;
 use imesh_quad::Remesh;
 use rayon::prelude::*;
 
+use crate::variables::{by_quad, colour, vertex_quads};
 use crate::Setup;
 
 /// One G' edge's boundary path: the pieces (M edges) in order along it, and the quad vertices
 /// on it; vertex `j` sits at `along[j]` (piece `⌊along⌋`, parameter `along − ⌊along⌋` on it).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct Chain {
     pieces: Vec<CubicBezier>,
     vertices: Vec<u32>,
@@ -69,18 +70,14 @@ impl Sliders {
         for (_, mut list) in by_graph_edge {
             let lo = |i: &usize| edge_curves[*i].parameters[0].min(edge_curves[*i].parameters[1]);
             list.sort_by(|a, b| lo(a).total_cmp(&lo(b)));
-            let mut chain = Chain {
-                pieces: Vec::new(),
-                vertices: Vec::new(),
-            };
+            let mut chain = Chain::default();
             for i in list {
                 let ec = &edge_curves[i];
                 let mut vertices = mesh.edge_vertices(t, elements, ec.edge);
                 let mut path = ec.path();
                 if ec.parameters[0] > ec.parameters[1] {
                     vertices.reverse();
-                    let c = path.control;
-                    path = CubicBezier::new([c[3], c[2], c[1], c[0]]);
+                    path = path.reversed();
                 }
                 let size = path.control[0].distance_squared(path.control[3]).sqrt();
                 let on_path = vertices.iter().enumerate().all(|(k, &v)| {
@@ -93,13 +90,7 @@ impl Sliders {
                 let continues = chain.vertices.last().is_none_or(|&v| v == vertices[0]);
                 if !on_path || !continues {
                     // A gap or a piece off its path: what came before is a chain of its own.
-                    chains.push(std::mem::replace(
-                        &mut chain,
-                        Chain {
-                            pieces: Vec::new(),
-                            vertices: Vec::new(),
-                        },
-                    ));
+                    chains.push(std::mem::take(&mut chain));
                     if !on_path {
                         continue;
                     }
@@ -121,21 +112,16 @@ impl Sliders {
                     .collect()
             })
             .collect();
-        let mut around = vec![Vec::new(); mesh.vertices.len()];
-        for (q, quad) in mesh.quads.iter().enumerate() {
-            for &v in quad {
-                around[v as usize].push(q as u32);
-            }
-        }
+        let around = vertex_quads(mesh);
         let mut slot = Vec::new();
         let mut quads = Vec::new();
         for (c, chain) in chains.iter().enumerate() {
             for j in 1..chain.vertices.len() - 1 {
                 slot.push((c as u32, j as u32));
-                quads.push(around[chain.vertices[j] as usize].clone());
+                quads.push(around.row(chain.vertices[j] as usize).to_vec());
             }
         }
-        let colours = colour(&quads, mesh.quads.len());
+        let colours = colour(&quads, &by_quad(&quads, mesh.quads.len()));
         Self {
             chains,
             slot,
@@ -261,27 +247,3 @@ impl Sliders {
 /// Golden-section steps per solve: the bracket shrinks to 0.618²⁰ ≈ 10⁻⁴ of the gap between
 /// the neighbours.
 const GOLDEN_STEPS: usize = 20;
-
-/// Greedy colouring: each slider takes the smallest colour no earlier slider sharing one of its
-/// quads has.
-fn colour(quads: &[Vec<u32>], n_quads: usize) -> Vec<Vec<u32>> {
-    let mut by_quad: Vec<Vec<u32>> = vec![Vec::new(); n_quads];
-    let mut colour_of = vec![usize::MAX; quads.len()];
-    let mut colours: Vec<Vec<u32>> = Vec::new();
-    for (i, qs) in quads.iter().enumerate() {
-        let taken: Vec<usize> = qs
-            .iter()
-            .flat_map(|&q| by_quad[q as usize].iter().map(|&j| colour_of[j as usize]))
-            .collect();
-        let c = (0..).find(|c| !taken.contains(c)).unwrap_or(0);
-        colour_of[i] = c;
-        if colours.len() <= c {
-            colours.resize(c + 1, Vec::new());
-        }
-        colours[c].push(i as u32);
-        for &q in qs {
-            by_quad[q as usize].push(i as u32);
-        }
-    }
-    colours
-}

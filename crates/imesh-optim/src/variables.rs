@@ -88,7 +88,7 @@ fn constrained_edges(t: &Triangulation, m: &ElementMesh) -> Vec<bool> {
 }
 
 /// Per quad vertex, the quads around it.
-fn vertex_quads(mesh: &QuadMesh) -> Rows<u32> {
+pub(crate) fn vertex_quads(mesh: &QuadMesh) -> Rows<u32> {
     let mut lists = vec![Vec::new(); mesh.vertices.len()];
     for (q, quad) in mesh.quads.iter().enumerate() {
         for &v in quad {
@@ -236,13 +236,7 @@ impl Variables {
                 qs
             })
             .collect();
-        let mut by_quad = vec![Vec::new(); mesh.quads.len()];
-        for (i, qs) in quads.iter().enumerate() {
-            for &q in qs {
-                by_quad[q as usize].push(i as u32);
-            }
-        }
-        let by_quad = Rows::from_lists(by_quad);
+        let by_quad = by_quad(&quads, mesh.quads.len());
         let colours = colour(&quads, &by_quad);
         Self {
             ids,
@@ -276,9 +270,20 @@ impl Variables {
     }
 }
 
+/// Per quad (of `n_quads`), the items whose quad lists (`quads`) hold it.
+pub(crate) fn by_quad(quads: &[Vec<u32>], n_quads: usize) -> Rows<u32> {
+    let mut lists = vec![Vec::new(); n_quads];
+    for (i, qs) in quads.iter().enumerate() {
+        for &q in qs {
+            lists[q as usize].push(i as u32);
+        }
+    }
+    Rows::from_lists(lists)
+}
+
 /// Greedy colouring of the variables: each takes the smallest colour no earlier variable sharing
 /// one of its quads has.
-fn colour(quads: &[Vec<u32>], by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
+pub(crate) fn colour(quads: &[Vec<u32>], by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
     let mut colour_of = vec![u32::MAX; quads.len()];
     let mut seen: Vec<usize> = Vec::new();
     let mut colours: Vec<Vec<u32>> = Vec::new();

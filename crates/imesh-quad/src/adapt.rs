@@ -300,8 +300,7 @@ fn piece_of(curve: &CubicBezier, u0: f64, u1: f64) -> CubicBezier {
     if u0 < u1 {
         curve.sub_curve(u0, u1)
     } else {
-        let c = curve.sub_curve(u1, u0).control;
-        CubicBezier::new([c[3], c[2], c[1], c[0]])
+        curve.sub_curve(u1, u0).reversed()
     }
 }
 
