@@ -228,3 +228,39 @@ pub struct Face {
     /// True when every edge of the walk carries `label` on the walked side.
     pub consistent: bool,
 }
+
+impl Face {
+    /// The length of the walk in `g` (the graph it was found in).
+    pub fn perimeter(&self, g: &CurveGraph) -> f64 {
+        self.walk
+            .iter()
+            .map(|&(e, _)| {
+                let [a, b] = g.edges()[e as usize].ends;
+                g.point(a).distance_squared(g.point(b)).sqrt()
+            })
+            .sum()
+    }
+
+    /// `2 · area / perimeter` in `g`: the width of a long strip, the radius of a disc, half the
+    /// side of a square; 0 for a walk of negative area (an island's outer side) or no length.
+    ///
+    /// ```
+    /// use imesh_curves::{CurveGraph, GraphEdge};
+    /// use imesh_geom::Point;
+    /// // A 10 × 1 strip (label 1) walked counter-clockwise; outside it label 0.
+    /// let points = vec![Point::new(0.0, 0.0), Point::new(10.0, 0.0), Point::new(10.0, 1.0), Point::new(0.0, 1.0)];
+    /// let edges = (0..4u32).map(|i| GraphEdge { ends: [i, (i + 1) % 4], labels: [1, 0] }).collect();
+    /// let g = CurveGraph::new(points, edges)?;
+    /// let strip = g.faces().into_iter().find(|f| f.label == 1).unwrap();
+    /// assert!((strip.width(&g) - 20.0 / 22.0).abs() < 1e-12);
+    /// # Ok::<(), imesh_curves::CurveError>(())
+    /// ```
+    pub fn width(&self, g: &CurveGraph) -> f64 {
+        let perimeter = self.perimeter(g);
+        if self.area > 0.0 && perimeter > 0.0 {
+            2.0 * self.area / perimeter
+        } else {
+            0.0
+        }
+    }
+}

@@ -26,7 +26,9 @@ pub mod traverse;
 
 pub use mesh::{SegmentedMesh, DEFAULT_MIN_ANGLE};
 pub use partition::{c_edges, partition, triangle_label, CEdge, OUTSIDE};
-pub use regions::{merge_thin_regions, MergeReport, PartitionRegion, PartitionRegions, NO_REGION};
+pub use regions::{
+    merge_regions, merge_thin_regions, MergeReport, PartitionRegion, PartitionRegions, NO_REGION,
+};
 pub use sample::{median_error, sample, MedianError, SampleOptions, Sampling};
 
 /// What can go wrong in the Imesh stages.

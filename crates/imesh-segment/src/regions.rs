@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use imesh_geom::Triangulation;
+use imesh_geom::{TriangleId, Triangulation};
 
 /// "No region" in [`PartitionRegions::of_triangle`] (ghost slots).
 pub const NO_REGION: u32 = u32::MAX;
@@ -189,8 +189,44 @@ pub struct MergeReport {
 /// assert_eq!(PartitionRegions::new(&t, &label).regions.len(), 1);
 /// ```
 pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) -> MergeReport {
+    merge_regions(t, label, min_width, &[])
+}
+
+/// [`merge_thin_regions`], and also the regions holding the triangles `also` whatever their
+/// width: regions that the partition finds wide enough but a later stage measures as too thin
+/// (a region that the curve simplification, within its tolerance, flattens into a sliver). Those
+/// go first, in their order of width, then the thin ones as [`merge_thin_regions`] does.
+/// `min_width ≤ 0` with `also` empty changes nothing.
+///
+/// ```
+/// use imesh_geom::{Point, Triangulation};
+/// use imesh_segment::{merge_regions, PartitionRegions};
+/// // A 10 × 10 square cut into two halves by x = 5: the left half's triangles are label 0.
+/// let pts = [
+///     Point::new(0.0, 0.0), Point::new(5.0, 0.0), Point::new(10.0, 0.0),
+///     Point::new(0.0, 10.0), Point::new(5.0, 10.0), Point::new(10.0, 10.0),
+/// ];
+/// let (t, _) = Triangulation::from_points(&pts).unwrap();
+/// let side = |f| u32::from(t.triangle_points(f).iter().map(|p| p.x).sum::<f64>() > 15.0);
+/// let mut label: Vec<u32> = (0..t.num_triangle_slots() as u32)
+///     .map(|i| imesh_geom::TriangleId::new(i))
+///     .map(|f| if t.is_triangle(f) { side(f) } else { imesh_segment::OUTSIDE })
+///     .collect();
+/// // Both halves are 5 wide: only the one named goes.
+/// let left = t.triangles().find(|&f| side(f) == 0).unwrap();
+/// let merged = merge_regions(&t, &mut label, 1.0, &[left]);
+/// assert_eq!(merged.regions, 1);
+/// assert!(t.triangles().all(|f| label[f.index()] == 1));
+/// ```
+pub fn merge_regions(
+    t: &Triangulation,
+    label: &mut [u32],
+    min_width: f64,
+    also: &[TriangleId],
+) -> MergeReport {
     let mut report = MergeReport::default();
-    if min_width.is_nan() || min_width <= 0.0 {
+    let min_width = if min_width.is_nan() { 0.0 } else { min_width };
+    if min_width <= 0.0 && also.is_empty() {
         return report;
     }
     let PartitionRegions {
@@ -199,6 +235,14 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
         mut shared,
     } = PartitionRegions::new(t, label);
     let n = regions.len();
+    let mut forced = vec![false; n];
+    for f in also {
+        if let Some(&r) = of_triangle.get(f.index()) {
+            if r != NO_REGION {
+                forced[r as usize] = true;
+            }
+        }
+    }
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn root(parent: &mut [u32], mut r: u32) -> u32 {
         while parent[r as usize] != r {
@@ -211,20 +255,27 @@ pub fn merge_thin_regions(t: &Triangulation, label: &mut [u32], min_width: f64) 
     // way (a speck merged into a strip widens it; a strip merged into a compact region may
     // make it thin), so each region is judged again when its turn comes, and every root again
     // in the next round.
+    // A forced region goes in the first round, before the thin ones.
+    let goes = |r: u32, regions: &[PartitionRegion], parent: &[u32]| {
+        parent[r as usize] == r && (forced[r as usize] || regions[r as usize].width() < min_width)
+    };
     loop {
         let mut queue: Vec<u32> = (0..n as u32)
-            .filter(|&r| parent[r as usize] == r && regions[r as usize].width() < min_width)
+            .filter(|&r| goes(r, &regions, &parent))
             .collect();
         if queue.is_empty() {
             break;
         }
         queue.sort_by(|&a, &b| {
             let (ra, rb) = (&regions[a as usize], &regions[b as usize]);
-            ra.width().total_cmp(&rb.width()).then(a.cmp(&b))
+            (!forced[a as usize])
+                .cmp(&!forced[b as usize])
+                .then(ra.width().total_cmp(&rb.width()))
+                .then(a.cmp(&b))
         });
         let mut merged_any = false;
         for &r in &queue {
-            if parent[r as usize] != r || regions[r as usize].width() >= min_width {
+            if !goes(r, &regions, &parent) {
                 continue;
             }
             // The neighbour with the longest shared boundary (ties to the lower id).

@@ -2,7 +2,9 @@
 //! labels, and keeps every label a label of the image.
 
 use imesh_classify::{LabelGrid, Region};
-use imesh_segment::{merge_thin_regions, partition, sample, PartitionRegions, SampleOptions};
+use imesh_segment::{
+    merge_regions, merge_thin_regions, partition, sample, PartitionRegions, SampleOptions,
+};
 use proptest::prelude::*;
 
 /// Random label images with specks, strips and blobs: a few labels on a coarse random grid,
@@ -68,6 +70,43 @@ proptest! {
         let total: f64 = regions_after.regions.iter().map(|r| r.area).sum();
         let domain = f64::from(grid.width()) * f64::from(grid.height());
         prop_assert!((total - domain).abs() <= 1e-9 * domain);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Every region named by a triangle is merged away (its triangles end in a larger region),
+    /// whatever its width, and no region thinner than asked is left.
+    #[test]
+    fn named_regions_are_merged_whatever_their_width(
+        grid in label_image(),
+        min_width in 0.0..2.0f64,
+        picks in prop::collection::vec(any::<prop::sample::Index>(), 1..4),
+    ) {
+        let sampling = sample(&grid, &SampleOptions::default()).unwrap();
+        let t = &sampling.triangulation;
+        let before = partition(&grid, t);
+        let regions_before = PartitionRegions::new(t, &before);
+        let triangles: Vec<_> = t.triangles().collect();
+        let named: Vec<_> = picks.iter().map(|i| *i.get(&triangles)).collect();
+        let mut after = before.clone();
+        let report = merge_regions(t, &mut after, min_width, &named);
+        let regions_after = PartitionRegions::new(t, &after);
+        if regions_before.regions.len() == 1 {
+            prop_assert_eq!(report.regions, 0);
+            prop_assert_eq!(&after, &before);
+        } else {
+            for f in &named {
+                let old = &regions_before.regions[regions_before.of_triangle[f.index()] as usize];
+                let new = &regions_after.regions[regions_after.of_triangle[f.index()] as usize];
+                prop_assert!(new.area > old.area, "a named region was kept");
+            }
+            if regions_after.regions.len() > 1 {
+                prop_assert!(regions_after.regions.iter().all(|r| r.width() >= min_width));
+            }
+        }
+        prop_assert!(regions_after.regions.len() + report.regions <= regions_before.regions.len());
     }
 }
 

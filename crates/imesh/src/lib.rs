@@ -24,9 +24,10 @@ use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
 use imesh_curves::{
-    contract_short_links, fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions,
+    contract_short_links, fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, Simplification,
+    SimplifyOptions,
 };
-use imesh_geom::{RefineOptions, StopReason};
+use imesh_geom::{RefineOptions, StopReason, TriangleId, Triangulation, VertexId};
 use imesh_io::SegmentedMeshData;
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
@@ -35,7 +36,8 @@ use imesh_quality::{
     QuadQuality, Statistics, TriangleQuality,
 };
 use imesh_segment::{
-    merge_thin_regions, partition, sample, MergeReport, SampleOptions, SegmentedMesh,
+    c_edges, merge_regions, merge_thin_regions, partition, sample, CEdge, MergeReport,
+    SampleOptions, SegmentedMesh, OUTSIDE,
 };
 use serde::{Deserialize, Serialize};
 
@@ -112,6 +114,10 @@ pub const LINK_SHARE: f64 = 0.5;
 /// The automatic [`MeshOptions::min_width`], as a share of the quad size: a region thinner than
 /// half a quad can only be filled with quads of a fraction of the mean area.
 pub const AUTO_MIN_WIDTH: f64 = 0.5;
+
+/// Most rounds of merging the regions that simplification flattened below the minimum width,
+/// each followed by the curve stage again.
+pub const THIN_FACE_ROUNDS: usize = 3;
 
 impl FromStr for ElementSize {
     type Err = String;
@@ -389,7 +395,8 @@ pub struct Counts {
     pub cleaned_pixels: usize,
     /// Pixel centres Imesh sampled.
     pub sampled_vertices: usize,
-    /// Regions of the partition merged into a neighbour for being thinner than `min_width`.
+    /// Regions of the partition merged into a neighbour for being thinner than `min_width`,
+    /// in the partition or, once simplified, in G'.
     pub merged_regions: usize,
     /// Their area in square pixels.
     pub merged_area: f64,
@@ -830,18 +837,30 @@ impl Pipeline {
         let min_width = o
             .min_width
             .unwrap_or_else(|| quad_size.map_or(0.0, |q| AUTO_MIN_WIDTH * q));
-        let merged = match o.elements {
+        let (w, h) = (grid.width(), grid.height());
+        let mut merged = match o.elements {
             Elements::Quad => merge_thin_regions(&sampling.triangulation, &mut label, min_width),
             Elements::Tri => MergeReport::default(),
         };
-        let mut segmented =
-            SegmentedMesh::from_partition(sampling, label, grid.width(), grid.height())?;
+        let sampled = start.elapsed().as_secs_f64();
+        let curves = match o.elements {
+            Elements::Quad => {
+                self.stage(Stage::Curves);
+                let t = &sampling.triangulation;
+                let (c, m) = self.curves_wide_enough(t, &mut label, w, h, quad_size, min_width)?;
+                merged.regions += m.regions;
+                merged.area += m.area;
+                Some(c)
+            }
+            Elements::Tri => None,
+        };
+        let mut segmented = SegmentedMesh::from_partition(sampling, label, w, h)?;
         let mut seconds = StageSeconds {
             classify: classified,
-            sample: start.elapsed().as_secs_f64(),
+            sample: sampled,
+            curves: start.elapsed().as_secs_f64() - sampled,
             ..Default::default()
         };
-        let (w, h) = (grid.width(), grid.height());
         let mut counts = Counts {
             width: w,
             height: h,
@@ -888,10 +907,10 @@ impl Pipeline {
             (Vec::new(), Vec::new(), Vec::new(), c_edge_lines(&segmented))
         });
         let mut optimised = None;
-        let (vertices, elements, labels) = match o.elements {
-            Elements::Tri => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
-            Elements::Quad => self.quads(
-                &segmented,
+        let (vertices, elements, labels) = match curves {
+            None => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
+            Some(curves) => self.quads(
+                curves,
                 quad_size,
                 &mut counts,
                 &mut seconds,
@@ -1035,20 +1054,19 @@ impl Pipeline {
     }
 
     /// The quad output: curves, DT', pairing, templates and boundary adaptation.
-    fn quads(
+    /// The curve stage of the quad output: the boundary graph G of the partition `label` of
+    /// `t`, its short links contracted (uniform quads), simplified into G'.
+    fn curves(
         &self,
-        segmented: &SegmentedMesh,
+        t: &Triangulation,
+        label: &[u32],
+        width: u32,
+        height: u32,
         quad_size: Option<f64>,
-        counts: &mut Counts,
-        seconds: &mut StageSeconds,
-        optimised: &mut Option<QuadExtras>,
-        pictures: &mut Pictures,
-    ) -> Result<MeshArrays, PipelineError> {
+    ) -> Result<Curves, PipelineError> {
         let o = &self.options;
-        let start = Instant::now();
-        self.stage(Stage::Curves);
-        let g = boundary_graph(segmented)?;
-        let g = match quad_size {
+        let g = graph_of_c_edges(t, &c_edges(t, label), width, height)?;
+        let (g, contracted) = match quad_size {
             // Junctions closer than a fraction of a quad (four regions meeting at a pixel
             // corner) would pin a boundary piece that short, and quads that small around it.
             Some(q) => {
@@ -1056,13 +1074,12 @@ impl Pipeline {
                     &g,
                     LINK_SHARE * q,
                     o.tolerance,
-                    f64::from(segmented.width),
-                    f64::from(segmented.height),
+                    f64::from(width),
+                    f64::from(height),
                 )?;
-                counts.contracted_links = c.contracted;
-                c.graph
+                (c.graph, c.contracted)
             }
-            None => g,
+            None => (g, 0),
         };
         let simplified = simplify(
             &g,
@@ -1071,9 +1088,65 @@ impl Pipeline {
                 min_length: quad_size.map_or(0.0, |q| MIN_PIECE * q),
             },
         )?;
+        Ok(Curves {
+            g,
+            simplified,
+            contracted,
+        })
+    }
+
+    /// [`Pipeline::curves`], then, while G' has faces narrower than `min_width` (simplification
+    /// may flatten a region the partition found wide enough into a sliver: its tolerance is
+    /// about a quad side), their regions merged into their neighbours and the curves drawn
+    /// again, at most [`THIN_FACE_ROUNDS`] times (merged regions are gone for good, so a few
+    /// rounds suffice). Returns the curves and what the merges did.
+    fn curves_wide_enough(
+        &self,
+        t: &Triangulation,
+        label: &mut [u32],
+        width: u32,
+        height: u32,
+        quad_size: Option<f64>,
+        min_width: f64,
+    ) -> Result<(Curves, MergeReport), PipelineError> {
+        let mut merged = MergeReport::default();
+        let mut c = self.curves(t, label, width, height, quad_size)?;
+        for _ in 0..THIN_FACE_ROUNDS {
+            let thin = thin_faces(&c.simplified, t, label, min_width);
+            let m = merge_regions(t, label, min_width, &thin);
+            if m.regions == 0 {
+                break;
+            }
+            merged.regions += m.regions;
+            merged.area += m.area;
+            c = self.curves(t, label, width, height, quad_size)?;
+        }
+        Ok((c, merged))
+    }
+
+    /// The quad output: curve fitting, DT', pairing, templates, boundary adaptation and
+    /// optimisation, from the curve stage's G'.
+    fn quads(
+        &self,
+        curves: Curves,
+        quad_size: Option<f64>,
+        counts: &mut Counts,
+        seconds: &mut StageSeconds,
+        optimised: &mut Option<QuadExtras>,
+        pictures: &mut Pictures,
+    ) -> Result<MeshArrays, PipelineError> {
+        let o = &self.options;
+        let start = Instant::now();
+        let Curves {
+            g,
+            simplified,
+            contracted,
+        } = curves;
+        counts.contracted_links = contracted;
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
-        seconds.curves = start.elapsed().as_secs_f64();
+        let fitting = start.elapsed().as_secs_f64();
+        seconds.curves += fitting;
         pictures.add("simplified", || {
             let points: Vec<[f64; 2]> = simplified
                 .graph
@@ -1115,7 +1188,7 @@ impl Pipeline {
             }
             e => PipelineError::Quads(e),
         })?;
-        seconds.quads = start.elapsed().as_secs_f64() - seconds.curves;
+        seconds.quads = start.elapsed().as_secs_f64() - fitting;
         seconds.dt = r.seconds.triangulation;
         seconds.pairing_templates = r.seconds.templates;
         seconds.adaptation = r.seconds.adaptation;
@@ -1417,8 +1490,23 @@ pub fn boundary_weighted_width(
 /// # Errors
 /// [`imesh_curves::CurveError`] if the c-edges do not make a valid graph (a bug in the sampler).
 pub fn boundary_graph(segmented: &SegmentedMesh) -> Result<CurveGraph, imesh_curves::CurveError> {
-    let edges = segmented
-        .c_edges
+    graph_of_c_edges(
+        &segmented.triangulation,
+        &segmented.c_edges,
+        segmented.width,
+        segmented.height,
+    )
+}
+
+/// The boundary graph of the c-edges `edges` of `t` over a `width` × `height` domain: the
+/// triangulation's points (G's vertex ids are `t`'s), the domain corners pinned.
+fn graph_of_c_edges(
+    t: &Triangulation,
+    edges: &[CEdge],
+    width: u32,
+    height: u32,
+) -> Result<CurveGraph, imesh_curves::CurveError> {
+    let edges = edges
         .iter()
         .map(|e| GraphEdge {
             ends: e.vertices.map(|v| v.index() as u32),
@@ -1426,11 +1514,52 @@ pub fn boundary_graph(segmented: &SegmentedMesh) -> Result<CurveGraph, imesh_cur
         })
         .collect();
     CurveGraph::image_boundaries(
-        segmented.triangulation.points().to_vec(),
+        t.points().to_vec(),
         edges,
-        f64::from(segmented.width),
-        f64::from(segmented.height),
+        f64::from(width),
+        f64::from(height),
     )
+}
+
+/// The curve stage's result (quads): G (contracted) and its simplification G'.
+struct Curves {
+    g: CurveGraph,
+    simplified: Simplification,
+    contracted: usize,
+}
+
+/// One triangle of `t` inside each face of G' (`s.graph`, whose edge `k` replaces the chain
+/// `s.chains[k]` of G's vertices, which are `t`'s) narrower than `min_width` (see
+/// [`imesh_curves::Face::width`]): a region that simplification flattened. The triangle is the one
+/// on the face's side of the first G edge of the face's walk that is an edge of `t`, under
+/// `label`; a face whose walk finds none is left out.
+fn thin_faces(
+    s: &Simplification,
+    t: &Triangulation,
+    label: &[u32],
+    min_width: f64,
+) -> Vec<TriangleId> {
+    let (graph, chains) = (&s.graph, &s.chains);
+    if min_width.is_nan() || min_width <= 0.0 {
+        return Vec::new();
+    }
+    graph
+        .faces()
+        .iter()
+        .filter(|f| f.consistent && f.label != OUTSIDE && f.area > 0.0)
+        .filter(|f| f.width(graph) < min_width)
+        .filter_map(|f| {
+            f.walk.iter().find_map(|&(e, forward)| {
+                chains.get(e as usize)?.windows(2).find_map(|w| {
+                    let (a, b) = if forward { (w[0], w[1]) } else { (w[1], w[0]) };
+                    let h = t.find_edge(VertexId::new(a), VertexId::new(b))?;
+                    let inside = t.triangle_of(h);
+                    (t.is_triangle(inside) && label.get(inside.index()) == Some(&f.label))
+                        .then_some(inside)
+                })
+            })
+        })
+        .collect()
 }
 
 /// The area of the equilateral triangle of side `s`.
@@ -1515,4 +1644,53 @@ fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: 
         }
     }
     agrees.iter().filter(|&&a| a).count() as f64 / (w * h) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On coins (Otsu, the default options), simplification flattens a small coin fragment the
+    /// partition found wide enough into a sliver of G'; the curve stage merges it, and leaves
+    /// G' with no face narrower than the minimum width, having changed only the labels of the
+    /// regions it merged.
+    #[test]
+    fn the_curve_stage_leaves_no_face_narrower_than_the_minimum_width() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
+        let image = load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+        let grid = classify(&image, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
+        let pipeline = Pipeline::new(MeshOptions::default());
+        let quad_size = pipeline.quad_size(&grid);
+        let q = quad_size.unwrap();
+        let (grid, _) = pipeline.clean_up(&grid, auto_majority(q)).unwrap();
+        let sampling = sample(&grid, &SampleOptions::default()).unwrap();
+        let t = &sampling.triangulation;
+        let min_width = AUTO_MIN_WIDTH * q;
+        let mut label = partition(&grid, t);
+        merge_thin_regions(t, &mut label, min_width);
+        let (w, h) = (grid.width(), grid.height());
+        let first = pipeline.curves(t, &label, w, h, quad_size).unwrap();
+        let thin = thin_faces(&first.simplified, t, &label, min_width);
+        assert!(!thin.is_empty(), "coins has a flattened region");
+        let before = label.clone();
+        let (c, merged) = pipeline
+            .curves_wide_enough(t, &mut label, w, h, quad_size, min_width)
+            .unwrap();
+        assert!(merged.regions >= thin.len());
+        assert!(thin_faces(&c.simplified, t, &label, min_width).is_empty());
+        for face in c.simplified.graph.faces() {
+            if face.consistent && face.label != OUTSIDE && face.area > 0.0 {
+                assert!(face.width(&c.simplified.graph) >= min_width);
+            }
+        }
+        // The triangles named have changed label, and no more area than the merges report.
+        assert!(thin.iter().all(|f| label[f.index()] != before[f.index()]));
+        let changed: f64 = t
+            .triangles()
+            .filter(|f| label[f.index()] != before[f.index()])
+            .map(|f| t.signed_area(f).abs())
+            .sum();
+        assert!(changed > 0.0 && changed <= merged.area * (1.0 + 1e-9));
+    }
 }
