@@ -63,8 +63,10 @@ impl EdgeCurve {
 }
 
 /// A quad that adaptation leaves with a scaled Jacobian below both this and its straight value
-/// is repaired like an inverted one: the curve costs the element more than it is worth.
-pub const POOR_SCALED_JACOBIAN: f64 = 0.2;
+/// is repaired like an inverted one: the curve costs the element more than it is worth. The
+/// same bar as pairing's corners (the sine of about 20.5°): adaptation spoils no corner below
+/// what DT' and pairing allowed.
+pub const POOR_SCALED_JACOBIAN: f64 = 0.35;
 
 /// Moves the control points of every M edge on a G' edge onto the exact piece of that edge's
 /// fitted curve (`curves[k]` for G' edge `k`), re-evaluates Q, and repairs quads that turned

@@ -9,7 +9,7 @@ use imesh_curves::{
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
-    BOUNDARY_PIECE, POOR_SCALED_JACOBIAN,
+    BOUNDARY_PIECE, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -317,6 +317,19 @@ fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
             100.0 * matching.unpaired as f64 / total as f64
         );
         assert!(matching.unpaired < greedy.unpaired, "{name}");
+        // No matched quad has a corner worse than the bar (sine of its angle).
+        for e in &matching.elements {
+            let Element::Quad(corners) = *e else { continue };
+            let p = corners.map(|v| dt.triangulation.points()[v as usize]);
+            for k in 0..4 {
+                let (a, b) = (p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+                let sine = (a.x * b.y - a.y * b.x) / (a.x.hypot(a.y) * b.x.hypot(b.y));
+                assert!(
+                    sine >= MIN_MATCHING_CORNER,
+                    "{name}: a corner of sine {sine}"
+                );
+            }
+        }
         let r = run(
             &c,
             &QuadOptions {
