@@ -249,6 +249,13 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
 /// of ten, equal on the others.
 pub const MIN_MATCHING_CORNER: f64 = 0.35;
 
+/// An augmenting path never undoes a pair whose quad has a worst corner sine of at least this
+/// (the lattice's squares, and quads nearly as good): re-pairing them to free one triangle
+/// turns two squares into rhombi and lowers the mesh's shape-and-size more than the triangle's
+/// three quads would (measured on nine fixtures with the defaults: mean shape-and-size +0.002 to
+/// +0.018 on eight, −0.0005 on camera; worst scaled Jacobian equal, or 0.004 lower on coins).
+const KEEP_PAIR: f64 = 0.97;
+
 /// How many re-pairings an augmenting path may make.
 const MAX_AUGMENTING_DEPTH: usize = 8;
 
@@ -259,6 +266,13 @@ fn matching(t: &Triangulation) -> Vec<u32> {
             .filter(strictly_convex)
             .map(|q| scaled_jacobian(&q))
             .filter(|&w| w >= MIN_MATCHING_CORNER)
+    };
+    // Whether the pair of `n` and its partner `p` is one an augmenting path keeps.
+    let keeps = |n: TriangleId, p: u32| {
+        t.triangle_edges(n).into_iter().any(|h| {
+            t.neighbour(h).is_some_and(|m| m.index() == p as usize)
+                && good(h).is_some_and(|w| w >= KEEP_PAIR)
+        })
     };
     let mut candidates: Vec<(f64, HalfEdgeId)> =
         t.edges().filter_map(|h| good(h).map(|w| (w, h))).collect();
@@ -307,6 +321,9 @@ fn matching(t: &Triangulation) -> Vec<u32> {
                 if p == NONE {
                     end = Some(n);
                     break 'search;
+                }
+                if keeps(n, p) {
+                    continue;
                 }
                 if mark[p as usize] != round {
                     mark[p as usize] = round;

@@ -513,3 +513,68 @@ fn a_lattice_over_the_cap_is_refused() {
         Err(QuadError::LatticeTooFine { limit: 1000, .. })
     ));
 }
+
+/// On a uniform DT', the matching pairs every lattice cell (two lattice triangles of one label
+/// across an unconstrained diagonal) into its square: the squares pair first, and no augmenting
+/// path undoes them to free a triangle.
+#[test]
+fn the_matching_keeps_every_lattice_square() {
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let spacing = 6.0;
+        let dt = imesh_quad::RegionTriangulation::new(
+            &c.simplified.graph,
+            &DensityOptions {
+                spacing: Some(spacing),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let t = &dt.triangulation;
+        let (nx, ny) = ((c.width / spacing).round(), (c.height / spacing).round());
+        let (hx, hy) = (c.width / nx, c.height / ny);
+        // Four points that are the corners of one lattice cell, in any order.
+        let is_cell = |p: &[Point]| {
+            let (x0, y0) = p.iter().fold((f64::INFINITY, f64::INFINITY), |(x, y), q| {
+                (x.min(q.x), y.min(q.y))
+            });
+            let on = |v: f64, h: f64| (v / h - (v / h).round()).abs() < 1e-9;
+            on(x0, hx)
+                && on(y0, hy)
+                && [(0.0, 0.0), (hx, 0.0), (0.0, hy), (hx, hy)]
+                    .iter()
+                    .all(|&(dx, dy)| {
+                        p.iter()
+                            .any(|q| (q.x - x0 - dx).abs() < 1e-9 && (q.y - y0 - dy).abs() < 1e-9)
+                    })
+        };
+        let cells = t
+            .edges()
+            .filter(|&h| !t.is_constrained(h))
+            .filter_map(|h| {
+                let n = t.neighbour(h)?;
+                let f = t.triangle_of(h);
+                (t.label(f) == t.label(n)).then_some((f, n))
+            })
+            .filter(|&(f, n)| {
+                let mut p: Vec<Point> = t.triangle_points(f).to_vec();
+                p.extend(t.triangle_points(n));
+                p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+                p.dedup();
+                p.len() == 4 && is_cell(&p)
+            })
+            .count();
+        let matching = ElementMesh::pair(t, Pairing::Matching);
+        let squares = matching
+            .elements
+            .iter()
+            .filter_map(|e| match *e {
+                Element::Quad(q) => Some(q.map(|v| t.points()[v as usize])),
+                Element::Triangle(_) => None,
+            })
+            .filter(|p| is_cell(p))
+            .count();
+        assert!(cells > 100, "{name}: {cells} lattice cells");
+        assert_eq!(squares, cells, "{name}: lattice squares undone");
+    }
+}
