@@ -48,7 +48,9 @@ pub use distance::{segment_distance, segment_distance_squared, segment_parameter
 pub use graph::{CurveGraph, Face, GraphEdge};
 pub use grid::SegmentIndex;
 pub use polyline::{polylines, Polyline};
-pub use simplify::{simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN};
+pub use simplify::{
+    neck_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN,
+};
 
 /// Errors of the curve stage.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -653,3 +653,87 @@ pub(crate) fn encloses(points: &[Point], chain: &[u32], p: Point) -> bool {
     }
     winding != 0
 }
+
+/// The vertices of `g` that undo the necks simplification made: where an edge of G' (`s`, the
+/// simplification of `g`) passes closer than `min_width` to a vertex of G' that is neither one
+/// of its ends nor joined to one, the inner vertex of that edge's chain nearest the G' vertex,
+/// when it lies farther from it than the edge does (the chord cut into the face there). Pinned
+/// (see [`CurveGraph::pin`]) before simplifying again, they keep the boundary where the image
+/// has it at the narrowest places, so that no element there is made smaller than the image
+/// asks for.
+///
+/// ```
+/// use imesh_curves::{neck_vertices, simplify, CurveGraph, GraphEdge, SimplifyOptions};
+/// use imesh_geom::Point;
+/// // An arch (0–1–2) over a line (3–4–5) with a stem at 4: simplified at 1.5 px, the arch's
+/// // chord passes 0.2 px from the junction 4, where the image has 1.5 px.
+/// let p = Point::new;
+/// let points = vec![
+///     p(0.0, 2.8), p(5.0, 1.5), p(10.0, 2.8), p(0.0, 3.0), p(5.0, 3.0), p(10.0, 3.0), p(5.0, 5.0),
+/// ];
+/// let e = |a, b, labels| GraphEdge { ends: [a, b], labels };
+/// let edges = vec![
+///     e(0, 1, [1, 0]), e(1, 2, [1, 0]), e(3, 4, [2, 1]), e(4, 5, [2, 1]), e(4, 6, [2, 3]),
+/// ];
+/// let mut g = CurveGraph::new(points, edges)?;
+/// let options = SimplifyOptions::with_tolerance(1.5);
+/// let s = simplify(&g, &options)?;
+/// assert_eq!(s.chains.iter().find(|c| c[0] == 0).unwrap(), &[0, 1, 2]);
+/// assert_eq!(neck_vertices(&g, &s, 0.5), [1]);
+/// g.pin(1)?;
+/// let again = simplify(&g, &options)?;
+/// assert!(neck_vertices(&g, &again, 0.5).is_empty());
+/// # Ok::<(), imesh_curves::CurveError>(())
+/// ```
+pub fn neck_vertices(g: &CurveGraph, s: &Simplification, min_width: f64) -> Vec<u32> {
+    let gs = &s.graph;
+    if !(min_width.is_finite() && min_width > 0.0) {
+        return Vec::new();
+    }
+    let segments: Vec<[Point; 2]> = gs
+        .edges()
+        .iter()
+        .map(|e| e.ends.map(|v| gs.point(v)))
+        .collect();
+    let index = crate::grid::SegmentIndex::new(&segments, min_width);
+    let joined = |u: u32, w: u32| {
+        gs.incident(u)
+            .iter()
+            .any(|&e| gs.edges()[e as usize].ends.contains(&w))
+    };
+    let mut found = Vec::new();
+    for v in 0..gs.points().len() as u32 {
+        if gs.valence(v) == 0 {
+            continue;
+        }
+        let p = gs.point(v);
+        for k in index.near(p) {
+            let [a, b] = gs.edges()[k as usize].ends;
+            if a == v || b == v || joined(v, a) || joined(v, b) {
+                continue;
+            }
+            let [pa, pb] = segments[k as usize];
+            let d2 = segment_distance_squared(pa, pb, p);
+            if d2 >= min_width * min_width {
+                continue;
+            }
+            let chain = &s.chains[k as usize];
+            let inner = &chain[1..chain.len().saturating_sub(1)];
+            let nearest = inner.iter().copied().min_by(|&x, &y| {
+                let (dx, dy) = (
+                    g.point(x).distance_squared(p),
+                    g.point(y).distance_squared(p),
+                );
+                dx.total_cmp(&dy).then(x.cmp(&y))
+            });
+            if let Some(w) = nearest {
+                if g.point(w).distance_squared(p) > d2 {
+                    found.push(w);
+                }
+            }
+        }
+    }
+    found.sort_unstable();
+    found.dedup();
+    found
+}

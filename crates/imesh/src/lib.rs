@@ -24,8 +24,8 @@ use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
 use imesh_curves::{
-    contract_short_links, fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, Simplification,
-    SimplifyOptions,
+    contract_short_links, fit_edges, neck_vertices, simplify, CurveGraph, FitOptions, GraphEdge,
+    Simplification, SimplifyOptions,
 };
 use imesh_geom::{RefineOptions, StopReason, TriangleId, Triangulation, VertexId};
 use imesh_io::SegmentedMeshData;
@@ -114,6 +114,13 @@ pub const LINK_SHARE: f64 = 0.5;
 /// The automatic [`MeshOptions::min_width`], as a share of the quad size: a region thinner than
 /// half a quad can only be filled with quads of a fraction of the mean area.
 pub const AUTO_MIN_WIDTH: f64 = 0.5;
+
+/// Where simplification brings a vertex of G' closer than this many quad sides to an edge of
+/// G', the edge keeps the vertex of its chain nearest that vertex ([`imesh_curves::neck_vertices`]).
+pub const NECK_SHARE: f64 = 0.5;
+
+/// Most rounds of restoring necks.
+pub const NECK_ROUNDS: usize = 2;
 
 /// Most rounds of merging the regions that simplification flattened below the minimum width,
 /// each followed by the curve stage again.
@@ -402,6 +409,9 @@ pub struct Counts {
     pub merged_area: f64,
     /// Pairs of boundary junctions merged for being closer than [`LINK_SHARE`] quad sides.
     pub contracted_links: usize,
+    /// Boundary vertices kept where simplification would have narrowed a face below
+    /// [`NECK_SHARE`] quad sides.
+    pub kept_at_necks: usize,
     /// The side of the quads of a uniform mesh, in pixels (0 when graded or for triangles).
     pub quad_size: f64,
     /// c-edges of the partition.
@@ -1081,25 +1091,32 @@ impl Pipeline {
             }
             None => (g, 0),
         };
-        let simplified = simplify(
-            &g,
-            &SimplifyOptions {
-                tolerance: o.tolerance,
-                min_length: quad_size.map_or(0.0, |q| MIN_PIECE * q),
-            },
-        )?;
+        let simplified = simplify(&g, &self.simplify_options(quad_size))?;
         Ok(Curves {
             g,
             simplified,
             contracted,
+            necks: 0,
         })
+    }
+
+    /// The simplification options: the tolerance, and pieces of at least a quad side (uniform
+    /// quads).
+    fn simplify_options(&self, quad_size: Option<f64>) -> SimplifyOptions {
+        SimplifyOptions {
+            tolerance: self.options.tolerance,
+            min_length: quad_size.map_or(0.0, |q| MIN_PIECE * q),
+        }
     }
 
     /// [`Pipeline::curves`], then, while G' has faces narrower than `min_width` (simplification
     /// may flatten a region the partition found wide enough into a sliver: its tolerance is
     /// about a quad side), their regions merged into their neighbours and the curves drawn
     /// again, at most [`THIN_FACE_ROUNDS`] times (merged regions are gone for good, so a few
-    /// rounds suffice). Returns the curves and what the merges did.
+    /// rounds suffice). Then, with uniform quads, where a simplified edge cuts within
+    /// [`NECK_SHARE`] quad sides of another boundary's vertex, the edge keeps the vertex of its
+    /// chain nearest to it ([`neck_vertices`], pinned) and the curves are simplified again, at
+    /// most [`NECK_ROUNDS`] times. Returns the curves and what the merges did.
     fn curves_wide_enough(
         &self,
         t: &Triangulation,
@@ -1121,6 +1138,19 @@ impl Pipeline {
             merged.area += m.area;
             c = self.curves(t, label, width, height, quad_size)?;
         }
+        if let Some(q) = quad_size {
+            for _ in 0..NECK_ROUNDS {
+                let necks = neck_vertices(&c.g, &c.simplified, NECK_SHARE * q);
+                if necks.is_empty() {
+                    break;
+                }
+                c.necks += necks.len();
+                for v in necks {
+                    c.g.pin(v)?;
+                }
+                c.simplified = simplify(&c.g, &self.simplify_options(quad_size))?;
+            }
+        }
         Ok((c, merged))
     }
 
@@ -1141,8 +1171,10 @@ impl Pipeline {
             g,
             simplified,
             contracted,
+            necks,
         } = curves;
         counts.contracted_links = contracted;
+        counts.kept_at_necks = necks;
         let fits = fit_edges(&simplified, &g, &FitOptions::default());
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
         let fitting = start.elapsed().as_secs_f64();
@@ -1526,6 +1558,8 @@ struct Curves {
     g: CurveGraph,
     simplified: Simplification,
     contracted: usize,
+    /// Chain vertices kept at necks.
+    necks: usize,
 }
 
 /// One triangle of `t` inside each face of G' (`s.graph`, whose edge `k` replaces the chain
@@ -1650,32 +1684,49 @@ fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: 
 mod tests {
     use super::*;
 
+    /// What the curve stage starts from on fixture `name` with the default options: the
+    /// pipeline, the cleaned grid, its sampling, the partition after the thin-region merge, the
+    /// quad size and the minimum width.
+    fn partitioned(
+        name: &str,
+    ) -> (
+        Pipeline,
+        LabelGrid,
+        imesh_segment::Sampling,
+        Vec<u32>,
+        f64,
+        f64,
+    ) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/images")
+            .join(name);
+        let image = load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
+        let grid = classify(&image, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
+        let pipeline = Pipeline::new(MeshOptions::default());
+        let q = pipeline.quad_size(&grid).unwrap();
+        let (grid, _) = pipeline.clean_up(&grid, auto_majority(q)).unwrap();
+        let sampling = sample(&grid, &SampleOptions::default()).unwrap();
+        let min_width = AUTO_MIN_WIDTH * q;
+        let mut label = partition(&grid, &sampling.triangulation);
+        merge_thin_regions(&sampling.triangulation, &mut label, min_width);
+        (pipeline, grid, sampling, label, q, min_width)
+    }
+
     /// On coins (Otsu, the default options), simplification flattens a small coin fragment the
     /// partition found wide enough into a sliver of G'; the curve stage merges it, and leaves
     /// G' with no face narrower than the minimum width, having changed only the labels of the
     /// regions it merged.
     #[test]
     fn the_curve_stage_leaves_no_face_narrower_than_the_minimum_width() {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
-        let image = load_image(&path, imesh_classify::DEFAULT_MAX_PIXELS).unwrap();
-        let grid = classify(&image, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
-        let pipeline = Pipeline::new(MeshOptions::default());
-        let quad_size = pipeline.quad_size(&grid);
-        let q = quad_size.unwrap();
-        let (grid, _) = pipeline.clean_up(&grid, auto_majority(q)).unwrap();
-        let sampling = sample(&grid, &SampleOptions::default()).unwrap();
+        let (pipeline, grid, sampling, mut label, q, min_width) = partitioned("skimage-coins.png");
         let t = &sampling.triangulation;
-        let min_width = AUTO_MIN_WIDTH * q;
-        let mut label = partition(&grid, t);
-        merge_thin_regions(t, &mut label, min_width);
         let (w, h) = (grid.width(), grid.height());
-        let first = pipeline.curves(t, &label, w, h, quad_size).unwrap();
+        let first = pipeline.curves(t, &label, w, h, Some(q)).unwrap();
         let thin = thin_faces(&first.simplified, t, &label, min_width);
         assert!(!thin.is_empty(), "coins has a flattened region");
         let before = label.clone();
         let (c, merged) = pipeline
-            .curves_wide_enough(t, &mut label, w, h, quad_size, min_width)
+            .curves_wide_enough(t, &mut label, w, h, Some(q), min_width)
             .unwrap();
         assert!(merged.regions >= thin.len());
         assert!(thin_faces(&c.simplified, t, &label, min_width).is_empty());
@@ -1692,5 +1743,23 @@ mod tests {
             .map(|f| t.signed_area(f).abs())
             .sum();
         assert!(changed > 0.0 && changed <= merged.area * (1.0 + 1e-9));
+    }
+
+    /// On the pyvista label map, simplification narrows faces below half a quad side in places
+    /// where the image is wider; the curve stage keeps the boundary there, and leaves no such
+    /// neck in G'.
+    #[test]
+    fn the_curve_stage_keeps_the_boundary_at_necks() {
+        let (pipeline, grid, sampling, mut label, q, min_width) =
+            partitioned("pyvista-channels_z050_labels.png");
+        let t = &sampling.triangulation;
+        let (w, h) = (grid.width(), grid.height());
+        let (c, _) = pipeline
+            .curves_wide_enough(t, &mut label, w, h, Some(q), min_width)
+            .unwrap();
+        assert!(c.necks > 0, "pyvista has necks");
+        assert!(neck_vertices(&c.g, &c.simplified, NECK_SHARE * q).is_empty());
+        // Still within the tolerance of the image's boundaries.
+        assert!(c.simplified.max_deviation <= pipeline.options.tolerance);
     }
 }
