@@ -50,6 +50,7 @@ pub use grid::SegmentIndex;
 pub use polyline::{polylines, Polyline};
 pub use simplify::{
     neck_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN,
+    NECK_RATIO,
 };
 
 /// Errors of the curve stage.
