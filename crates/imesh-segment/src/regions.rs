@@ -251,14 +251,14 @@ pub fn merge_regions(
         }
         r
     }
-    // Rounds over the thin regions, thinnest first. A merge changes the target's width either
-    // way (a speck merged into a strip widens it; a strip merged into a compact region may
-    // make it thin), so each region is judged again when its turn comes, and every root again
-    // in the next round.
     // A forced region goes in the first round, before the thin ones.
     let goes = |r: u32, regions: &[PartitionRegion], parent: &[u32]| {
         parent[r as usize] == r && (forced[r as usize] || regions[r as usize].width() < min_width)
     };
+    // Rounds over the thin regions, thinnest first. A merge changes the target's width either
+    // way (a speck merged into a strip widens it; a strip merged into a compact region may
+    // make it thin), so each region is judged again when its turn comes, and every root again
+    // in the next round.
     loop {
         let mut queue: Vec<u32> = (0..n as u32)
             .filter(|&r| goes(r, &regions, &parent))

@@ -116,7 +116,8 @@ pub const LINK_SHARE: f64 = 0.5;
 pub const AUTO_MIN_WIDTH: f64 = 0.5;
 
 /// Where simplification brings a vertex of G' closer than this many quad sides to an edge of
-/// G', the edge keeps the vertex of its chain nearest that vertex ([`imesh_curves::neck_vertices`]).
+/// G', the edge keeps the vertex of its chain nearest that vertex, if that one is
+/// [`imesh_curves::NECK_RATIO`] times farther ([`imesh_curves::neck_vertices`]).
 pub const NECK_SHARE: f64 = 0.5;
 
 /// Most rounds of restoring necks.
@@ -1063,7 +1064,6 @@ impl Pipeline {
         Ok((vertices, elements, labels))
     }
 
-    /// The quad output: curves, DT', pairing, templates and boundary adaptation.
     /// The curve stage of the quad output: the boundary graph G of the partition `label` of
     /// `t`, its short links contracted (uniform quads), simplified into G'.
     fn curves(
