@@ -3,8 +3,9 @@
 mod support;
 
 use imesh_curves::{
-    contract_short_links, fit_edges, polylines, segment_distance, simplify, CurveError, CurveGraph,
-    FitOptions, GraphEdge, SegmentIndex, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
+    contract_short_links, fit_edges, neck_vertices, polylines, segment_distance, simplify,
+    CurveError, CurveGraph, FitOptions, GraphEdge, SegmentIndex, Simplification, SimplifyOptions,
+    DEFAULT_TOLERANCE,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -560,4 +561,34 @@ fn a_short_piece_is_joined_with_a_neighbour() {
     assert!((s.max_deviation - 20.0 / 125f64.sqrt()).abs() < 1e-9);
     let ends: Vec<[u32; 2]> = s.graph.edges().iter().map(|e| e.ends).collect();
     assert!(ends.iter().any(|e| e.contains(&0)) && ends.iter().any(|e| e.contains(&3)));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The vertices kept at necks are inner vertices of the chains of G' edges that pass near
+    /// another G' vertex, farther from it than the edge; pinned, the graph
+    /// simplifies with its topology kept, and each of them is a vertex of the new G'.
+    #[test]
+    fn vertices_kept_at_necks_keep_the_topology((w, h, labels) in label_image()) {
+        let mut g = support::imesh_boundaries(&support::grid(w, h, labels));
+        for (tolerance, min_width) in [(1.0, 0.5), (2.0, 1.0), (3.0, 2.0)] {
+            let options = SimplifyOptions::with_tolerance(tolerance);
+            let s = simplify(&g, &options).unwrap();
+            let necks = neck_vertices(&g, &s, min_width);
+            for &v in &necks {
+                let inner = s.chains.iter().any(|c| c.len() > 2 && c[1..c.len() - 1].contains(&v));
+                prop_assert!(inner, "vertex {} is not inside a chain", v);
+                prop_assert!(s.graph.valence(v) == 0, "vertex {} is already in G'", v);
+            }
+            for &v in &necks {
+                g.pin(v).unwrap();
+            }
+            let again = simplify(&g, &options).unwrap();
+            check_simplification(&g, &again, tolerance);
+            for &v in &necks {
+                prop_assert!(again.graph.valence(v) > 0, "pinned vertex {} left G'", v);
+            }
+        }
+    }
 }
