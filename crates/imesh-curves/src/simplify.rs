@@ -666,10 +666,9 @@ pub const NECK_RATIO: f64 = 1.5;
 /// simplification of `g`) passes closer than `min_width` to a vertex of G' that is neither one
 /// of its ends nor joined to one, the inner vertex of that edge's chain nearest the G' vertex,
 /// when it lies [`NECK_RATIO`] times farther from it than the edge does (the chord cut into the
-/// face there). Pinned
-/// (see [`CurveGraph::pin`]) before simplifying again, they keep the boundary where the image
-/// has it at the narrowest places, so that no element there is made smaller than the image
-/// asks for.
+/// face there). Pinned (see [`CurveGraph::pin`]) before simplifying again, they keep the
+/// boundary where the image has it at the narrowest places, so that no element there is made
+/// smaller than the image asks for.
 ///
 /// ```
 /// use imesh_curves::{neck_vertices, simplify, CurveGraph, GraphEdge, SimplifyOptions};

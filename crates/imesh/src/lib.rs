@@ -1573,10 +1573,10 @@ fn thin_faces(
     label: &[u32],
     min_width: f64,
 ) -> Vec<TriangleId> {
-    let (graph, chains) = (&s.graph, &s.chains);
     if min_width.is_nan() || min_width <= 0.0 {
         return Vec::new();
     }
+    let (graph, chains) = (&s.graph, &s.chains);
     graph
         .faces()
         .iter()
