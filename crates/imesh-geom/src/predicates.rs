@@ -96,7 +96,14 @@ const LATTICE_SPAN: i64 = 1 << 30;
 #[inline]
 fn lattice(v: f64) -> Option<i64> {
     let s = v * f64::from(1 << LATTICE_BITS);
-    (s == s.trunc() && s.abs() < 4.0e15).then_some(s as i64)
+    // `as` truncates toward zero inline (`trunc` is a libm call on baseline x86-64); the range
+    // test first keeps the conversion exact (and rejects NaN).
+    if s.abs() < 4.0e15 {
+        let i = s as i64;
+        (i as f64 == s).then_some(i)
+    } else {
+        None
+    }
 }
 
 /// `p − o` in lattice units, when both are lattice points close enough together.

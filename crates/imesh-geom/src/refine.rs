@@ -410,35 +410,42 @@ impl Triangulation {
                 Target::Blocked(h) => Plan::Split(vec![self.edge_ends(h)]),
                 Target::Found { triangle } => {
                     let lens = queues.lens;
-                    let objection = self.insert_unless(c, triangle, |tri, touched| {
-                        // Segments of the cavity that the point would encroach go first.
-                        let threatened: Vec<[u32; 2]> = touched
-                            .iter()
-                            .map(|&e| tri.edge_ends(e))
-                            .filter(|&[u, w]| {
-                                let [pu, pw] = [u, w].map(|x| tri.points[x as usize]);
-                                in_diametral_lens(pu, pw, c, lens)
-                            })
-                            .collect();
-                        if !threatened.is_empty() {
-                            return Some(Plan::Split(threatened));
+                    // A segment of the triangle that holds the point bounds its cavity: when the
+                    // point encroaches one, the cavity need not be dug to know it.
+                    let early = self.encroached_sides(triangle, c, lens);
+                    if !early.is_empty() {
+                        Plan::Split(early)
+                    } else {
+                        let objection = self.insert_unless(c, triangle, |tri, touched| {
+                            // Segments of the cavity that the point would encroach go first.
+                            let threatened: Vec<[u32; 2]> = touched
+                                .iter()
+                                .map(|&e| tri.edge_ends(e))
+                                .filter(|&[u, w]| {
+                                    let [pu, pw] = [u, w].map(|x| tri.points[x as usize]);
+                                    in_diametral_lens(pu, pw, c, lens)
+                                })
+                                .collect();
+                            if !threatened.is_empty() {
+                                return Some(Plan::Split(threatened));
+                            }
+                            let candidate = Candidate {
+                                bad: TriangleId(t),
+                                point: c,
+                                containing: TriangleId(triangle),
+                            };
+                            (!(tri.refinable(triangle) && policy(tri, &candidate)))
+                                .then_some(Plan::GiveUp)
+                        })?;
+                        match objection {
+                            Err(plan) => plan,
+                            Ok(Inserted::New) => {
+                                self.after_insertion(&mut queues, &mut report);
+                                continue;
+                            }
+                            // The point is a vertex already.
+                            Ok(Inserted::Duplicate(_)) => Plan::GiveUp,
                         }
-                        let candidate = Candidate {
-                            bad: TriangleId(t),
-                            point: c,
-                            containing: TriangleId(triangle),
-                        };
-                        (!(tri.refinable(triangle) && policy(tri, &candidate)))
-                            .then_some(Plan::GiveUp)
-                    })?;
-                    match objection {
-                        Err(plan) => plan,
-                        Ok(Inserted::New) => {
-                            self.after_insertion(&mut queues, &mut report);
-                            continue;
-                        }
-                        // The point is a vertex already.
-                        Ok(Inserted::Duplicate(_)) => Plan::GiveUp,
                     }
                 }
             };
@@ -594,6 +601,20 @@ impl Triangulation {
                 }
             }
         }
+    }
+
+    /// The constrained edges of triangle `t` that `p` encroaches.
+    fn encroached_sides(&self, t: u32, p: Point, lens: f64) -> Vec<[u32; 2]> {
+        if self.segment.is_empty() {
+            return Vec::new();
+        }
+        (3 * t..3 * t + 3)
+            .filter(|&e| self.segment[e as usize] != NONE)
+            .map(|e| self.edge_ends(e))
+            .filter(|&[u, w]| {
+                in_diametral_lens(self.points[u as usize], self.points[w as usize], p, lens)
+            })
+            .collect()
     }
 
     /// The apex of a real refinable triangle beside constrained half-edge `e` that lies strictly

@@ -169,6 +169,10 @@ impl Triangulation {
 
     /// The first step of the straight walk from `a` to `b` (within the convex hull).
     fn first_step(&self, a: u32, b: u32) -> Option<Step> {
+        // Most segments are edges already: find those by their ends before any geometry.
+        if let Some(h) = self.star(a).find(|&h| self.origin[next(h) as usize] == b) {
+            return Some(Step::AlongEdge(h, b));
+        }
         let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
         for h in self.star(a) {
             let u = self.origin[next(h) as usize];

@@ -449,11 +449,17 @@ impl Triangulation {
     }
 
     /// True when `p` sees every (real) boundary edge of the cavity strictly from inside.
+    ///
+    /// Only constrained edges and hull edges can fail. Across any other boundary edge the
+    /// triangulation is locally Delaunay, so the part of the inner triangle's circumdisk beyond
+    /// the edge lies inside the outer triangle's circumdisk: `p`, inside the first and outside
+    /// the second, is strictly on the inner side.
     fn cavity_is_star_shaped(&self, boundary: &[(u32, u32, u32)], p: Point) -> bool {
-        boundary.iter().all(|&(x, _, e)| {
+        boundary.iter().all(|&(x, o, e)| {
             let y = self.origin[next(e) as usize];
             x == GHOST
                 || y == GHOST
+                || (self.segment[e as usize] == NONE && !self.is_ghost_slot(o / 3))
                 || orient2d(self.points[x as usize], self.points[y as usize], p) > 0.0
         })
     }
