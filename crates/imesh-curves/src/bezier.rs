@@ -110,10 +110,12 @@ impl CubicBezier {
     pub fn closest_parameter(&self, q: Point, guess: f64) -> f64 {
         let distance = |t: f64| self.eval(t).distance_squared(q);
         let mut best = guess.clamp(0.0, 1.0);
+        let mut nearest = distance(best);
         for k in 0..=16 {
             let t = f64::from(k) / 16.0;
-            if distance(t) < distance(best) {
-                best = t;
+            let d = distance(t);
+            if d < nearest {
+                (best, nearest) = (t, d);
             }
         }
         self.newton_projection(q, best)

@@ -244,11 +244,13 @@ pub fn adapt(
                 }
             }
         }
-        // Moved corners change the neighbours' vertices too: re-evaluate before the next check.
-        for &index in &next {
-            q.evaluate_element(m, net, index);
-        }
+        // Every element a damped curve moved (its sides, or a corner) is relaxed and evaluated
+        // again at the start of the next round, before any check.
         bad = next;
+    }
+    // Unless the rounds ran out first.
+    for &index in &bad {
+        q.evaluate_element(m, net, index);
     }
     report.relaxed_patches = relaxed.iter().filter(|&&r| r).count();
     report.damped_curves = damped.iter().filter(|&&d| d).count();

@@ -175,13 +175,13 @@ impl QuadMesh {
         let element = &m.elements[index];
         let template = &self.templates[usize::from(matches!(element, Element::Quad(_)))];
         let first = self.point_first[index] as usize;
-        for (i, (weights, place)) in template.weights.iter().zip(&template.places).enumerate() {
+        for (i, (terms, place)) in template.terms.iter().zip(&template.places).enumerate() {
             let v = self.points[first + i] as usize;
             self.vertices[v] = match *place {
                 Place::Side { side, .. } => {
-                    net.eval_on_side(element, index, weights, side as usize)
+                    net.eval_terms_on_side(element, index, terms, side as usize)
                 }
-                _ => net.eval_weights(index, weights),
+                _ => net.eval_terms(index, terms),
             };
         }
     }

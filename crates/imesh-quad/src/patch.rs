@@ -129,7 +129,22 @@ impl ControlNet {
         weights: &[f64; 16],
         side: usize,
     ) -> Point {
-        let mut p = self.eval_weights(k, weights);
+        self.snap_to_side(element, k, side, self.eval_weights(k, weights))
+    }
+
+    /// [`ControlNet::eval_on_side`] for the nonzero weights only (`(slot, weight)` in slot
+    /// order, as [`crate::Template::terms`] has them): the same point.
+    pub fn eval_terms_on_side(
+        &self,
+        element: &Element,
+        k: usize,
+        terms: &[(u8, f64)],
+        side: usize,
+    ) -> Point {
+        self.snap_to_side(element, k, side, self.eval_terms(k, terms))
+    }
+
+    fn snap_to_side(&self, element: &Element, k: usize, side: usize, mut p: Point) -> Point {
         let c = self.side_points(element, k, side);
         if c.iter().all(|q| q.x == c[0].x) {
             p.x = c[0].x;
@@ -143,6 +158,19 @@ impl ControlNet {
     /// The inner control points of M edge `e` (at 1/3 and 2/3 along its direction).
     pub fn edge_inner(&self, e: u32) -> [u32; 2] {
         [self.edge_base + 2 * e, self.edge_base + 2 * e + 1]
+    }
+
+    /// [`ControlNet::eval_weights`] for the nonzero weights only, `(slot, weight)` in slot order
+    /// (as [`crate::Template::terms`] has them): the same sum, term for term.
+    pub fn eval_terms(&self, k: usize, terms: &[(u8, f64)]) -> Point {
+        let slots = &self.patches[k];
+        let (mut x, mut y) = (0.0, 0.0);
+        for &(slot, w) in terms {
+            let p = self.points[slots[usize::from(slot)] as usize];
+            x += w * p.x;
+            y += w * p.y;
+        }
+        Point::new(x, y)
     }
 
     /// The point of element `k`'s patch for precomputed basis weights (see [`basis`]).

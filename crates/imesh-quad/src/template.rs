@@ -42,6 +42,10 @@ pub struct Template {
     pub level: u32,
     /// The Bézier basis weights of each point (see [`crate::patch::basis`]).
     pub weights: Vec<[f64; 16]>,
+    /// The same weights without the zeros, as `(slot, weight)` in slot order: a corner has one,
+    /// a point on a side four, so evaluating them costs a fraction of the sixteen-slot sum (and
+    /// gives the same bits: the same products added in the same order).
+    pub terms: Vec<Vec<(u8, f64)>>,
 }
 
 impl Template {
@@ -141,9 +145,19 @@ fn build(
             }
         }
     }
-    let weights = coords
+    let weights: Vec<[f64; 16]> = coords
         .iter()
         .map(|&uv| crate::patch::basis(quad, uv))
+        .collect();
+    let terms = weights
+        .iter()
+        .map(|w| {
+            (0u8..16)
+                .zip(w)
+                .filter(|&(_, &w)| w != 0.0)
+                .map(|(slot, &w)| (slot, w))
+                .collect()
+        })
         .collect();
     Template {
         coords,
@@ -152,6 +166,7 @@ fn build(
         inside,
         level: k,
         weights,
+        terms,
     }
 }
 
