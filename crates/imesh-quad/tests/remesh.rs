@@ -9,7 +9,7 @@ use imesh_curves::{
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
-    BOUNDARY_PIECE, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
+    BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -462,6 +462,15 @@ fn a_uniform_dt_is_a_valid_mesh_of_lattice_squares_inside() {
             );
         }
         assert!(lattice > 0, "{name}: no lattice point inside");
+        // No triangle larger than the bound (refinement was not capped).
+        assert_eq!(r.dt.refinement.stopped, imesh_geom::StopReason::Done);
+        for f in t.triangles() {
+            assert!(
+                t.signed_area(f) <= MAX_TRIANGLE_AREA * spacing * spacing * (1.0 + 1e-9),
+                "{name}: a triangle of area {} at spacing {spacing}",
+                t.signed_area(f)
+            );
+        }
         // Quads that are exact squares of side spacing / 2 (before adaptation and optimisation).
         let squares = |r: &Remesh| {
             r.mesh
