@@ -50,7 +50,7 @@ pub use grid::SegmentIndex;
 pub use polyline::{polylines, Polyline};
 pub use simplify::{
     neck_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN,
-    NECK_RATIO,
+    NECK_RATIO, WEDGE_ANGLE_DEG,
 };
 
 /// Errors of the curve stage.

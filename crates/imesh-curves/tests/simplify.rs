@@ -592,3 +592,47 @@ proptest! {
         }
     }
 }
+
+/// A thin wedge at a junction: an edge whose chord passes 0.2 px from the far end of another
+/// edge leaving the same vertex 2.3° away is a neck; 60° away it is an ordinary junction.
+#[test]
+fn a_thin_wedge_at_a_junction_is_a_neck() {
+    // Edge 0–1–2–3 (simplified at 1.5 px to its chord, 5.7° above the x axis); the edge 0–4 to
+    // a junction 4, whose stem 4–5 leaves on the side away from the chord.
+    let necks = |far: Point, stem: Point| -> Result<Vec<u32>, imesh_curves::CurveError> {
+        let p = Point::new;
+        let points = vec![
+            p(0.0, 0.0),
+            p(4.0, 1.6),
+            p(10.0, 1.2),
+            p(20.0, 2.0),
+            far,
+            stem,
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let edges = vec![
+            e(0, 1, [1, 0]),
+            e(1, 2, [1, 0]),
+            e(2, 3, [1, 0]),
+            e(0, 4, [2, 1]),
+            e(4, 5, [2, 3]),
+        ];
+        let g = CurveGraph::new(points, edges)?;
+        let s = simplify(&g, &SimplifyOptions::with_tolerance(1.5))?;
+        assert!(s.chains.contains(&vec![0, 1, 2, 3]));
+        Ok(neck_vertices(&g, &s, 0.5))
+    };
+    // 3.4° above the x axis, 2.3° below the chord, 0.2 px from it: the chord's chain keeps the
+    // vertex nearest the junction.
+    let far = Point::new(5.0, 0.3);
+    assert_eq!(necks(far, Point::new(5.0, -4.7)).unwrap(), [1]);
+    // 60° above the chord, 0.22 px from it: an ordinary junction.
+    let a = 65.7f64.to_radians();
+    let far = Point::new(0.25 * a.cos(), 0.25 * a.sin());
+    assert!(necks(far, Point::new(far.x, far.y + 5.0))
+        .unwrap()
+        .is_empty());
+}
