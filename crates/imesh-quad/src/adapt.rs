@@ -246,12 +246,6 @@ pub fn adapt(
         }
         // Every element a damped curve moved (its sides, or a corner) is relaxed and evaluated
         // again at the start of the next round, before any check.
-        if std::env::var_os("IMESH_FILTER").is_some() {
-            for &index in &next {
-                q.evaluate_element(m, net, index);
-            }
-            next.retain(|&i| needs_repair(q, i));
-        }
         bad = next;
     }
     // Unless the rounds ran out first.
