@@ -609,16 +609,12 @@ fn a_thin_wedge_at_a_junction_is_a_neck() {
             far,
             stem,
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         let edges = vec![
-            e(0, 1, [1, 0]),
-            e(1, 2, [1, 0]),
-            e(2, 3, [1, 0]),
-            e(0, 4, [2, 1]),
-            e(4, 5, [2, 3]),
+            edge(0, 1, [1, 0]),
+            edge(1, 2, [1, 0]),
+            edge(2, 3, [1, 0]),
+            edge(0, 4, [2, 1]),
+            edge(4, 5, [2, 3]),
         ];
         let g = CurveGraph::new(points, edges)?;
         let s = simplify(&g, &SimplifyOptions::with_tolerance(1.5))?;
