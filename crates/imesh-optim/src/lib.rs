@@ -230,6 +230,10 @@ pub(crate) struct Setup<'a> {
     pub settled_term: f64,
 }
 
+/// How far above a scaled-Jacobian floor a quad's shape must be for the floor to hold without
+/// computing the Jacobian: far above the rounding of either.
+const JACOBIAN_MARGIN: f64 = 1e-9;
+
 impl Setup<'_> {
     /// The metric of quad `q` over `vertices`.
     pub fn value(&self, vertices: &[Point], q: usize) -> f64 {
@@ -270,9 +274,12 @@ impl Setup<'_> {
         }
         let (s, shape) = self.quality(p);
         let jacobian = self.jacobian_floors[quad];
+        // At every corner the scaled Jacobian α / (|a| |b|) is at least the shape's
+        // 2α / (|a|² + |b|²): a shape clear of the floor spares computing the Jacobian.
         (s >= self.floor
             && shape >= self.shape_floors[quad]
             && (jacobian == f64::NEG_INFINITY
+                || shape >= jacobian + JACOBIAN_MARGIN
                 || imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y])) >= jacobian))
             .then_some((s, shape))
     }

@@ -22,14 +22,11 @@ struct LocalEnergy<'a> {
     setup: Setup<'a>,
 }
 
-/// `base + δ · w`, written once so that the solve and the update compute the same bits.
+/// `base + δ · w`, written once so that the solve and the update compute the same bits (a
+/// weight of 0 leaves `base` as it is: δ is always finite).
 #[inline]
 pub(crate) fn moved(base: Point, delta: Point, w: f64) -> Point {
-    if w == 0.0 {
-        base
-    } else {
-        Point::new(base.x + delta.x * w, base.y + delta.y * w)
-    }
+    Point::new(base.x + delta.x * w, base.y + delta.y * w)
 }
 
 impl LocalEnergy<'_> {
@@ -152,9 +149,10 @@ fn solve(
         LocalSolver::Powell => Powell::new(0.2 * size)
             .with_tolerance(1e-4)
             .with_line_search(1e-2, LINE_EVALUATIONS)
-            .minimise(
+            .minimise_from(
                 |x| local.energy(Point::new(x[0], x[1])),
                 vec![0.0, 0.0],
+                start,
                 setup.local_iterations,
             ),
         LocalSolver::Lbfgs => {

@@ -255,9 +255,12 @@ impl Variables {
 
     /// The weight of variable `i` in vertex `v` (0 when it does not move it).
     pub fn weight(&self, i: usize, v: u32) -> f64 {
-        let row = self.influence.row(i);
-        row.binary_search_by_key(&v, |&(u, _)| u)
-            .map_or(0.0, |at| row[at].1)
+        // Rows are short (a point moves at most a patch's vertices): a scan beats a search.
+        self.influence
+            .row(i)
+            .iter()
+            .find(|&&(u, _)| u == v)
+            .map_or(0.0, |&(_, w)| w)
     }
 
     /// True when `p` lies strictly left of every ring edge of variable `i` (control points

@@ -76,8 +76,9 @@ impl Corners {
 /// Raw edges and signed corner areas `α_k = sign(N_c) · c_k`, and the squared bounding-box
 /// diagonal `h²` (1 for a point-like quad): what shape, size and area need, without the per-element
 /// scaling, which cancels in their ratios (the thresholds are compared against `h²` instead).
+/// The raw edges `L_k` and signed corner areas `α_k` of `q`.
 #[inline]
-fn raw_corners(q: &Quad) -> ([Point2; 4], [f64; 4], f64) {
+fn edges_and_alpha(q: &Quad) -> ([Point2; 4], [f64; 4]) {
     let edges = [
         sub(q[1], q[0]),
         sub(q[2], q[1]),
@@ -96,6 +97,13 @@ fn raw_corners(q: &Quad) -> ([Point2; 4], [f64; 4], f64) {
         sign * cross(edges[1], edges[2]),
         sign * cross(edges[2], edges[3]),
     ];
+    (edges, alpha)
+}
+
+/// The squared diagonal of the bounding box of `q` (1 when it vanishes): Verdict's scale for
+/// a tiny edge.
+#[inline]
+fn box_diagonal2(q: &Quad) -> f64 {
     let (xl, xh) = (
         q[0][0].min(q[1][0]).min(q[2][0].min(q[3][0])),
         q[0][0].max(q[1][0]).max(q[2][0].max(q[3][0])),
@@ -104,20 +112,32 @@ fn raw_corners(q: &Quad) -> ([Point2; 4], [f64; 4], f64) {
         q[0][1].min(q[1][1]).min(q[2][1].min(q[3][1])),
         q[0][1].max(q[1][1]).max(q[2][1].max(q[3][1])),
     );
-    let mut h2 = (xh - xl) * (xh - xl) + (yh - yl) * (yh - yl);
+    let h2 = (xh - xl) * (xh - xl) + (yh - yl) * (yh - yl);
     if h2 < DBL_MIN * DBL_MIN {
-        h2 = 1.0;
+        1.0
+    } else {
+        h2
     }
-    (edges, alpha, h2)
 }
 
-/// Shape from raw corner data.
 #[inline]
-fn shape_of(edges: &[Point2; 4], alpha: &[f64; 4], h2: f64) -> f64 {
+fn shape_of(edges: &[Point2; 4], alpha: &[f64; 4], h2: impl FnOnce() -> f64) -> f64 {
     let len2 = edges.map(|l| dot(l, l));
-    let tiny = DBL_MIN * h2;
-    if len2.iter().any(|&l| l <= tiny) {
-        return 0.0;
+    // Verdict calls an edge tiny against the bounding box's diagonal. A closed polygon spans at
+    // most half its summed |x| steps across and half its |y| steps up, so the box is needed only
+    // when an edge is that short against twice this bound (a margin over rounding).
+    let (sx, sy) = (
+        edges[0][0].abs() + edges[1][0].abs() + edges[2][0].abs() + edges[3][0].abs(),
+        edges[0][1].abs() + edges[1][1].abs() + edges[2][1].abs() + edges[3][1].abs(),
+    );
+    let shortest = len2[0].min(len2[1]).min(len2[2].min(len2[3]));
+    // (False for a NaN coordinate too, which then takes Verdict's own test.)
+    let clear_of_the_bar = shortest > DBL_MIN * 0.5 * (sx * sx + sy * sy);
+    if !clear_of_the_bar {
+        let tiny = DBL_MIN * h2();
+        if len2.iter().any(|&l| l <= tiny) {
+            return 0.0;
+        }
     }
     let mut worst = alpha[0] / (len2[0] + len2[3]);
     worst = worst.min(alpha[1] / (len2[1] + len2[0]));
@@ -131,7 +151,6 @@ fn shape_of(edges: &[Point2; 4], alpha: &[f64; 4], h2: f64) -> f64 {
     }
 }
 
-/// Relative size squared from the Verdict area.
 #[inline]
 fn relative_size_of(area: f64, average_area: f64) -> f64 {
     if average_area <= DBL_MIN {
@@ -157,7 +176,7 @@ fn collapsed(q: &Quad) -> Option<[Point2; 3]> {
 /// assert_eq!(imesh_quality::quad::area(&[[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]]), 2.0);
 /// ```
 pub fn area(q: &Quad) -> f64 {
-    let (_, alpha, _) = raw_corners(q);
+    let (_, alpha) = edges_and_alpha(q);
     0.25 * (alpha[0] + alpha[1] + alpha[2] + alpha[3])
 }
 
@@ -170,8 +189,8 @@ pub fn area(q: &Quad) -> f64 {
 /// assert_eq!(shape(&[[0.0, 0.0], [2.0, 1.0], [0.0, 2.0], [0.5, 1.0]]), 0.0); // arrow head
 /// ```
 pub fn shape(q: &Quad) -> f64 {
-    let (edges, alpha, h2) = raw_corners(q);
-    shape_of(&edges, &alpha, h2)
+    let (edges, alpha) = edges_and_alpha(q);
+    shape_of(&edges, &alpha, || box_diagonal2(q))
 }
 
 /// Relative size squared: `min(R, 1/R)²` with `R = area / average_area`.
@@ -195,9 +214,9 @@ pub fn relative_size_squared(q: &Quad, average_area: f64) -> f64 {
 /// assert!((shape_and_size(&q2, 5.0 / 3.0) - 5.0 / 12.0).abs() < 1e-15);
 /// ```
 pub fn shape_and_size(q: &Quad, average_area: f64) -> f64 {
-    let (edges, alpha, h2) = raw_corners(q);
+    let (edges, alpha) = edges_and_alpha(q);
     let area = 0.25 * (alpha[0] + alpha[1] + alpha[2] + alpha[3]);
-    shape_of(&edges, &alpha, h2) * relative_size_of(area, average_area)
+    shape_of(&edges, &alpha, || box_diagonal2(q)) * relative_size_of(area, average_area)
 }
 
 /// Scaled Jacobian: the minimum signed sine of the corner angles, `min_k α_k / (|L_k| |L_{k−1}|)`.

@@ -150,6 +150,46 @@ fn statistics_use_the_sample_variance_and_skip_nans() {
     assert_eq!(h.bin_edges(1), (0.25, 0.5));
 }
 
+/// Verdict's quad shape written out plainly: 0 when an edge is tiny against the bounding box's
+/// diagonal, else twice the least `α_k / (|L_k|² + |L_{k−1}|²)`, the corner areas signed by
+/// the centre normal.
+fn verdict_shape(q: &quad::Quad) -> f64 {
+    let dbl_min = imesh_quality::DBL_MIN;
+    let edge = |k: usize| [q[(k + 1) % 4][0] - q[k][0], q[(k + 1) % 4][1] - q[k][1]];
+    let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
+    let len2: Vec<f64> = (0..4)
+        .map(|k| edge(k)[0].powi(2) + edge(k)[1].powi(2))
+        .collect();
+    let (xs, ys) = (q.map(|p| p[0]), q.map(|p| p[1]));
+    let span = |v: [f64; 4]| {
+        v.iter().copied().fold(f64::MIN, f64::max) - v.iter().copied().fold(f64::MAX, f64::min)
+    };
+    let mut h2 = span(xs).powi(2) + span(ys).powi(2);
+    if h2 < dbl_min * dbl_min {
+        h2 = 1.0;
+    }
+    if len2.iter().any(|&l| l <= dbl_min * h2) {
+        return 0.0;
+    }
+    let x1 = [edge(0)[0] - edge(2)[0], edge(0)[1] - edge(2)[1]];
+    let x2 = [edge(1)[0] - edge(3)[0], edge(1)[1] - edge(3)[1]];
+    let nc = cross(x1, x2);
+    let sign = if nc.abs() <= 2.0 * dbl_min {
+        0.0
+    } else {
+        nc.signum()
+    };
+    let worst = (0..4)
+        .map(|k| sign * cross(edge((k + 3) % 4), edge(k)) / (len2[k] + len2[(k + 3) % 4]))
+        .fold(f64::INFINITY, f64::min);
+    let s = 2.0 * worst;
+    if s < dbl_min {
+        0.0
+    } else {
+        s
+    }
+}
+
 fn convex_quad() -> impl Strategy<Value = quad::Quad> {
     // Four angles on an ellipse, in counter-clockwise order: a convex quad.
     (
@@ -200,6 +240,17 @@ proptest! {
         let r = [q[k], q[(k + 1) % 4], q[(k + 2) % 4], q[(k + 3) % 4]];
         prop_assert!((quad::shape_and_size(&q, avg) - quad::shape_and_size(&r, avg)).abs() < 1e-12);
         prop_assert!((quad::scaled_jacobian(&q) - quad::scaled_jacobian(&r)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_tiny_edge_is_judged_against_the_bounding_box(q in convex_quad(), exponent in -9.0f64..-6.0, k in 0usize..4) {
+        // Vertex k + 1 slid towards vertex k: edge k at 1e-9 to 1e-6 of its length, across
+        // Verdict's tiny-edge bar (|L|² ≤ DBL_MIN · the box's squared diagonal).
+        let mut t = q;
+        let (a, b) = (q[k], q[(k + 1) % 4]);
+        let f = 10f64.powf(exponent);
+        t[(k + 1) % 4] = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
+        prop_assert_eq!(quad::shape(&t).to_bits(), verdict_shape(&t).to_bits());
     }
 
     #[test]
