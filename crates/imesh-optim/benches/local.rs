@@ -10,7 +10,6 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use imesh_classify::{label_map, majority_filter, remove_small_regions};
-use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
 use imesh_optim::{optimise, Method, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 
@@ -25,13 +24,7 @@ fn bench(c: &mut Criterion) {
         .expect("the fixture pyvista-channels_z050_labels.png loads");
     let labels = label_map(&image, 64).expect("the fixture is a label map");
     let grid = remove_small_regions(&majority_filter(&labels, 2, 1), 16);
-    let g = support::imesh_boundaries(&grid);
-    let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
-    let curves: Vec<_> = fit_edges(&s, &g, &FitOptions::default())
-        .fits
-        .iter()
-        .map(|f| f.curve)
-        .collect();
+    let (_, s, curves) = support::simplified_with_curves(&grid);
     let options = QuadOptions {
         density: DensityOptions {
             spacing: Some(4.0),

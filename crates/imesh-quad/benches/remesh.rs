@@ -9,7 +9,6 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use imesh_classify::{luminance, multi_otsu_levels, threshold};
-use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
 use imesh_quad::{
     adapt, ControlNet, DensityOptions, ElementMesh, Pairing, QuadMesh, RegionTriangulation,
 };
@@ -25,13 +24,7 @@ fn bench(c: &mut Criterion) {
         .expect("the fixture skimage-grass.png loads");
     let grey = luminance(&image);
     let grid = threshold(&grey, &multi_otsu_levels(&grey, 2));
-    let g = support::imesh_boundaries(&grid);
-    let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
-    let curves: Vec<_> = fit_edges(&s, &g, &FitOptions::default())
-        .fits
-        .iter()
-        .map(|f| f.curve)
-        .collect();
+    let (g, s, curves) = support::simplified_with_curves(&grid);
     let dt = RegionTriangulation::new(&s.graph, &DensityOptions::default()).expect("DT' builds");
     let triangles = dt.triangulation.num_triangles();
     eprintln!(

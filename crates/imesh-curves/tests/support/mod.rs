@@ -5,7 +5,10 @@
 use std::collections::HashMap;
 
 use imesh_classify::{LabelGrid, Region};
-use imesh_curves::{CurveGraph, GraphEdge};
+use imesh_curves::{
+    fit_edges, simplify, CubicBezier, CurveGraph, FitOptions, GraphEdge, Simplification,
+    SimplifyOptions,
+};
 use imesh_geom::Point;
 use imesh_segment::{SampleOptions, SegmentedMesh, OUTSIDE};
 
@@ -99,4 +102,17 @@ pub fn imesh_boundaries(grid: &LabelGrid) -> CurveGraph {
     let (w, h) = (f64::from(grid.width()), f64::from(grid.height()));
     CurveGraph::image_boundaries(m.triangulation.points().to_vec(), edges, w, h)
         .expect("valid c-edges")
+}
+
+/// The c-edge graph of `grid`, its simplification G' at the default tolerance, and the cubic
+/// fitted to each edge of G' (the quad stage's input, as the benchmarks build it).
+pub fn simplified_with_curves(grid: &LabelGrid) -> (CurveGraph, Simplification, Vec<CubicBezier>) {
+    let g = imesh_boundaries(grid);
+    let s = simplify(&g, &SimplifyOptions::default()).expect("simplification works");
+    let curves = fit_edges(&s, &g, &FitOptions::default())
+        .fits
+        .iter()
+        .map(|f| f.curve)
+        .collect();
+    (g, s, curves)
 }
