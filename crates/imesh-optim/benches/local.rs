@@ -1,7 +1,8 @@
 //! Criterion benchmark of the optimiser on a real label image's quad mesh (PyVista's channels
-//! slice, 250 × 250, 4 labels, smoothed by a majority filter of radius 2 and its small regions merged; DT' spacing 4 px as the command line's
-//! automatic size picks for it: about 1.5 · 10^4 quads), in the default `local` mode and its
-//! `vertex` and `laplacian` baselines, on the threads rayon gives it.
+//! slice, 250 × 250, 4 labels, smoothed by a majority filter of radius 2 and its small regions
+//! merged; DT' spacing 4 px as the command line's automatic size picks for it: about 1.5 · 10^4
+//! quads), in the default `local` mode and its `vertex` and `laplacian` baselines, on the
+//! threads rayon gives it.
 //!
 //! `cargo bench -p imesh-optim`.
 

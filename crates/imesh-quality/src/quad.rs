@@ -73,10 +73,9 @@ impl Corners {
     }
 }
 
-/// Raw edges and signed corner areas `α_k = sign(N_c) · c_k`, and the squared bounding-box
-/// diagonal `h²` (1 for a point-like quad): what shape, size and area need, without the per-element
-/// scaling, which cancels in their ratios (the thresholds are compared against `h²` instead).
-/// The raw edges `L_k` and signed corner areas `α_k` of `q`.
+/// Raw edges `L_k` and signed corner areas `α_k = sign(N_c) · c_k`: what shape, size and area
+/// need, without the per-element scaling, which cancels in their ratios (the thresholds are
+/// compared against the squared bounding-box diagonal, [`box_diagonal2`], instead).
 #[inline]
 fn edges_and_alpha(q: &Quad) -> ([Point2; 4], [f64; 4]) {
     let edges = [
@@ -120,6 +119,7 @@ fn box_diagonal2(q: &Quad) -> f64 {
     }
 }
 
+/// Shape from raw corner data, `h2` giving the squared bounding-box diagonal if it is needed.
 #[inline]
 fn shape_of(edges: &[Point2; 4], alpha: &[f64; 4], h2: impl FnOnce() -> f64) -> f64 {
     let len2 = edges.map(|l| dot(l, l));
@@ -151,6 +151,7 @@ fn shape_of(edges: &[Point2; 4], alpha: &[f64; 4], h2: impl FnOnce() -> f64) -> 
     }
 }
 
+/// Relative size squared from the Verdict area.
 #[inline]
 fn relative_size_of(area: f64, average_area: f64) -> f64 {
     if average_area <= DBL_MIN {
