@@ -463,6 +463,8 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     } else {
         sweeps
     };
+    // Sliding re-evaluates boundary vertices on their curves, the border's too.
+    mesh.snap_to_border(t, elements);
     let energy_after = setup.energy(&mesh.vertices);
     let after = quality(&mesh.vertices, &mesh.quads);
     Ok(OptimReport {

@@ -195,6 +195,7 @@ pub fn remesh(
     let straight_vertices = mesh.vertices.clone();
     let templates = clock.elapsed().as_secs_f64() - triangulation;
     let (adaptation, edge_curves) = adapt(&dt, g, curves, &elements, &mut net, &mut mesh);
+    mesh.snap_to_border(&dt.triangulation, &elements);
     let seconds = RemeshSeconds {
         triangulation,
         templates,

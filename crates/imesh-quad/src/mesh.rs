@@ -160,6 +160,49 @@ impl QuadMesh {
         out
     }
 
+    /// Puts the vertices along every hull edge of M that is parallel to an axis exactly on that
+    /// edge's line (the image border, for DT' of an image). A template point on a straight
+    /// side is a weighted sum of control points that all share the line's coordinate, and the
+    /// weights sum to 1 only up to rounding: the point can land an ulp outside the domain, and
+    /// its sides off the border. Returns the number of coordinates moved.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// use imesh_quad::{ControlNet, ElementMesh, Pairing, QuadMesh};
+    /// let square = [(0.0, 0.0), (27.0, 0.0), (27.0, 27.0), (0.0, 27.0)].map(Point::from);
+    /// let (t, _) = Triangulation::from_points(&square)?;
+    /// let m = ElementMesh::pair(&t, Pairing::Greedy);
+    /// let net = ControlNet::straight(&t, &m);
+    /// let mut q = QuadMesh::build(&t, &m, &net, 3);
+    /// // The right side's points an ulp outside, as a rounded weighted sum can put them.
+    /// let outside = f64::from_bits(27f64.to_bits() + 1);
+    /// q.vertices.iter_mut().filter(|p| p.x == 27.0).for_each(|p| p.x = outside);
+    /// assert_eq!(q.snap_to_border(&t, &m), 7); // 3 · 2 + 1 points on that side
+    /// assert!(q.vertices.iter().all(|p| (0.0..=27.0).contains(&p.x)));
+    /// # Ok::<(), imesh_geom::GeomError>(())
+    /// ```
+    pub fn snap_to_border(&mut self, t: &Triangulation, m: &ElementMesh) -> usize {
+        let mut moved = 0;
+        for (e, &h) in m.edges.iter().enumerate() {
+            if t.neighbour(h).is_some() && t.neighbour(t.twin(h)).is_some() {
+                continue;
+            }
+            let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+            for v in self.edge_vertices(t, m, e as u32) {
+                let p = &mut self.vertices[v as usize];
+                if a.x == b.x && p.x != a.x {
+                    p.x = a.x;
+                    moved += 1;
+                }
+                if a.y == b.y && p.y != a.y {
+                    p.y = a.y;
+                    moved += 1;
+                }
+            }
+        }
+        moved
+    }
+
     /// The template level.
     pub fn level(&self) -> u32 {
         self.level
