@@ -2,7 +2,6 @@
 //! boundaries, never a worse worst quad, and the same result on any number of threads.
 
 use imesh_classify::LabelGrid;
-use imesh_curves::{fit_edges, simplify, FitOptions, SimplifyOptions};
 use imesh_geom::Point;
 use imesh_optim::{optimise, LocalSolver, Method, Metric, OptimOptions, OptimReport};
 use imesh_quad::{remesh, QuadOptions, Remesh};
@@ -12,10 +11,7 @@ use proptest::prelude::*;
 mod support;
 
 fn quad_mesh(grid: &LabelGrid) -> Remesh {
-    let g = support::imesh_boundaries(grid);
-    let s = simplify(&g, &SimplifyOptions::with_tolerance(2.0)).unwrap();
-    let fits = fit_edges(&s, &g, &FitOptions::default());
-    let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
+    let (_, s, curves) = support::simplified_with_curves(grid);
     remesh(&s.graph, &curves, &QuadOptions::default()).unwrap()
 }
 
@@ -365,10 +361,7 @@ fn settled_points_are_not_solved() {
         })
         .collect();
     let grid = support::grid(w, h, labels);
-    let g = support::imesh_boundaries(&grid);
-    let s = simplify(&g, &SimplifyOptions::default()).unwrap();
-    let fits = fit_edges(&s, &g, &FitOptions::default());
-    let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
+    let (_, s, curves) = support::simplified_with_curves(&grid);
     let mut options = QuadOptions::default();
     options.density.spacing = Some(4.0);
     let start = remesh(&s.graph, &curves, &options).unwrap();
