@@ -18,6 +18,8 @@ struct Row {
     name: String,
     width: u32,
     height: u32,
+    /// Pixels per side of the meshed grid's cells (1: no reduction).
+    reduction: u32,
     vertices: usize,
     quads: usize,
     seconds: Seconds,
@@ -101,6 +103,7 @@ fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Re
         name: name.to_string(),
         width: r.counts.width,
         height: r.counts.height,
+        reduction: r.counts.reduction,
         vertices: r.counts.vertices,
         quads: r.counts.quads,
         seconds: Seconds {
@@ -134,10 +137,15 @@ const HEADER: &str = "| image | size | vertices | quads | classify | sample | cu
 fn line(r: &Row) -> String {
     let s = &r.seconds;
     format!(
-        "| {} | {} × {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} % | {:.1} % |",
+        "| {} | {} × {}{} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} % | {:.1} % |",
         r.name,
         r.width,
         r.height,
+        if r.reduction > 1 {
+            format!(" (cells of {} px)", r.reduction)
+        } else {
+            String::new()
+        },
         r.vertices,
         r.quads,
         s.classify,
@@ -287,6 +295,15 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
             &resized,
             &MeshOptions::default(),
         )?);
+        // Where the default reduces the image, the same run on its pixels.
+        if scaling.last().is_some_and(|r| r.reduction > 1) {
+            let pixels = MeshOptions {
+                reduction: Some(1),
+                ..MeshOptions::default()
+            };
+            let name = format!("camera {side}², --reduction 1");
+            scaling.push(measure(&name, &resized, &pixels)?);
+        }
         side *= 2;
     }
     table("Scaling: the camera fixture resized (seconds)", &scaling);

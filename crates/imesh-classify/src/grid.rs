@@ -92,6 +92,11 @@ impl LabelGrid {
     /// Replaces the labels (same size), dropping labels no pixel uses any more and renumbering the
     /// rest in their previous order.
     pub(crate) fn with_labels(&self, labels: Vec<u32>) -> Self {
+        self.resized(self.width, self.height, labels)
+    }
+
+    /// [`LabelGrid::with_labels`] for a grid of another size (`labels` holds `width × height`).
+    pub(crate) fn resized(&self, width: u32, height: u32, labels: Vec<u32>) -> Self {
         let mut used = vec![false; self.regions.len()];
         for &l in &labels {
             used[l as usize] = true;
@@ -106,8 +111,8 @@ impl LabelGrid {
         }
         let labels = labels.into_iter().map(|l| new_id[l as usize]).collect();
         Self {
-            width: self.width,
-            height: self.height,
+            width,
+            height,
             labels,
             regions,
         }

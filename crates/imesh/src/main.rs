@@ -144,6 +144,12 @@ struct MeshFlags {
     /// uniform quads, none otherwise].
     #[arg(long)]
     min_width: Option<AutoOr<f64>>,
+    /// Mesh a reduced grid whose cells are the most common label of about F × F pixels, then
+    /// scale the mesh back: auto (uniform quads of automatic size over 8 px wide, i.e. large
+    /// images: F makes them 4 to 8 cells wide), 1 (never) or F. The options in pixels then
+    /// count cells [default: auto].
+    #[arg(long)]
+    reduction: Option<AutoOr<u32>>,
     /// Curve simplification tolerance in pixels [default: 2].
     #[arg(long)]
     tolerance: Option<f64>,
@@ -284,6 +290,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(w) = args.min_width {
         o.min_width = w.value();
+    }
+    if let Some(f) = args.reduction {
+        o.reduction = f.value();
     }
     if let Some(e) = args.elements {
         o.elements = e;
@@ -604,6 +613,14 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             );
         }
         println!("{line}");
+        if c.reduction > 1 {
+            println!(
+                "meshed on a {}×{} grid of cells of about {f}×{f} px (--reduction 1 meshes every pixel)",
+                c.grid_width,
+                c.grid_height,
+                f = c.reduction
+            );
+        }
     }
     Ok(())
 }

@@ -303,6 +303,24 @@ fn the_triangle_mesh_and_quad_options() {
         stat(&shape, "quality", "shape", "mean")
             > stat(&shape, "quality_before_optimisation", "shape", "mean")
     );
+    // A reduction by 2: meshed on 256 × 256 cells, written and measured on the 512 × 512 image.
+    let halved = run(&["--reduction", "2"], "r2.json");
+    let count = |r: &serde_json::Value, key: &str| r["counts"][key].as_u64().unwrap();
+    assert_eq!(count(&halved, "reduction"), 2);
+    assert_eq!(count(&halved, "grid_width"), 256);
+    assert_eq!(count(&halved, "width"), 512);
+    assert_eq!(count(&matching, "reduction"), 1);
+    assert!((halved["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    assert!(halved["label_agreement"].as_f64().unwrap() > 0.9);
+    let out = imesh(
+        &["mesh", image, "-o", "r2.msh", "--reduction", "2"],
+        dir.path(),
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("512×512 px") && said.contains("meshed on a 256×256 grid"),
+        "{said}"
+    );
 }
 
 #[test]
@@ -330,6 +348,11 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
             "neither auto nor a number",
         ),
         (&["mesh", image, "--min-width=-2"], "smallest region width"),
+        (&["mesh", image, "--reduction", "0"], "a reduction of 0"),
+        (
+            &["mesh", image, "--reduction", "half"],
+            "neither auto nor a number",
+        ),
         (
             &["mesh", image, "--size", "big"],
             "auto, graded or a positive",

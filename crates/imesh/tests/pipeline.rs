@@ -33,6 +33,11 @@ fn degenerate_images_give_valid_all_quad_meshes() {
             majority: Some(1),
             ..Default::default()
         },
+        // Cells of 3 × 3 pixels: a 1-pixel image is one cell, a 1-pixel line half a cell.
+        MeshOptions {
+            reduction: Some(3),
+            ..Default::default()
+        },
     ];
     for (name, picture) in degenerate_images() {
         for options in &variants {
@@ -55,15 +60,28 @@ fn degenerate_images_give_valid_all_quad_meshes() {
 #[test]
 fn the_triangle_path_stays_available() {
     for (name, picture) in degenerate_images() {
-        let options = MeshOptions {
-            elements: Elements::Tri,
-            ..Default::default()
-        };
-        let result = Pipeline::new(options)
-            .run_image(&picture)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(result.report.validation.valid, "{name}");
-        assert_eq!(result.report.counts.quads, 0, "{name}");
+        for reduction in [None, Some(2)] {
+            let options = MeshOptions {
+                elements: Elements::Tri,
+                reduction,
+                ..Default::default()
+            };
+            let result = Pipeline::new(options)
+                .run_image(&picture)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let r = &result.report;
+            assert!(r.validation.valid, "{name}");
+            assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "{name}");
+            assert_eq!(r.counts.quads, 0, "{name}");
+            // A reduction only where the image spans more than a cell.
+            let expected = match reduction {
+                Some(f) if r.counts.width.max(r.counts.height) > 1 => f,
+                _ => 1,
+            };
+            assert_eq!(r.counts.reduction, expected, "{name}");
+            let cells = |n: u32| (n + expected / 2) / expected;
+            assert_eq!(r.counts.grid_width, cells(r.counts.width).max(1), "{name}");
+        }
     }
 }
 
@@ -174,4 +192,71 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
     assert!(cleaned.counts.cleaned_pixels > 0);
     assert!(mean(&smoothed) > mean(&cleaned) + 0.05);
     assert!(smoothed.counts.cleaned_pixels > cleaned.counts.cleaned_pixels);
+}
+
+#[test]
+fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
+    let path = support::fixtures()
+        .into_iter()
+        .find(|p| p.ends_with("skimage-camera.png"))
+        .expect("the camera fixture");
+    // The camera at 1300 × 1100: quads of the automatic size are about 12 pixels wide.
+    let image = image::open(&path)
+        .expect("the camera fixture loads")
+        .resize_exact(1300, 1100, image::imageops::FilterType::Triangle);
+    let run = |options: MeshOptions| {
+        let result = Pipeline::new(options).run_image(&image).unwrap();
+        (result.mesh, result.report)
+    };
+    let (mesh, reduced) = run(MeshOptions::default());
+    let (_, pixels) = run(MeshOptions {
+        reduction: Some(1),
+        ..Default::default()
+    });
+    let c = &reduced.counts;
+    // q ≈ 12 px, so ⌊q / 4⌋ = 2: cells of 2 × 2 pixels, quads about 6 cells wide.
+    assert_eq!(
+        (c.reduction, c.grid_width, c.grid_height),
+        (2, 650, 550),
+        "quad size {}",
+        c.quad_size
+    );
+    assert_eq!((c.width, c.height), (1300, 1100));
+    assert_eq!((mesh.width, mesh.height), (1300, 1100));
+    assert_eq!(pixels.counts.reduction, 1);
+    assert_eq!(
+        (pixels.counts.grid_width, pixels.counts.grid_height),
+        (1300, 1100)
+    );
+    // Scaled back exactly onto the image: its corners and border, the whole area.
+    assert!(reduced.validation.valid);
+    assert!((reduced.validation.area_ratio - 1.0).abs() < 1e-9);
+    for corner in [[0.0, 0.0], [1300.0, 0.0], [1300.0, 1100.0], [0.0, 1100.0]] {
+        assert!(mesh.vertices.contains(&corner), "corner {corner:?}");
+    }
+    assert!(mesh
+        .vertices
+        .iter()
+        .all(|v| (0.0..=1300.0).contains(&v[0]) && (0.0..=1100.0).contains(&v[1])));
+    // Quads of about the same size either way, and the same share of the labels followed...
+    let quads = |r: &imesh::Report| r.counts.quads as f64;
+    assert!((quads(&reduced) / quads(&pixels) - 1.0).abs() < 0.25);
+    assert!((reduced.counts.quad_size / pixels.counts.quad_size - 1.0).abs() < 0.1);
+    assert!(reduced.label_agreement > 0.96);
+    assert!(reduced.label_agreement > pixels.label_agreement - 0.01);
+    // ... but better quads on the reduced grid.
+    let sns = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
+    let sj = |r: &imesh::Report| r.quality.scaled_jacobian().min;
+    eprintln!(
+        "reduced: mean S&S {:.3}, worst SJ {:.3}, agreement {:.4}; pixels: {:.3}, {:.3}, {:.4}",
+        sns(&reduced),
+        sj(&reduced),
+        reduced.label_agreement,
+        sns(&pixels),
+        sj(&pixels),
+        pixels.label_agreement
+    );
+    assert!(sns(&reduced) > sns(&pixels));
+    assert!(sns(&reduced) > 0.85);
+    assert!(sj(&reduced) > 0.3);
 }
