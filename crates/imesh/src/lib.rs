@@ -905,8 +905,13 @@ impl Pipeline {
         let (w, h) = (f64::from(original.width()), f64::from(original.height()));
         let (cw, ch) = (f64::from(mesh.width), f64::from(mesh.height));
         // (x · W) / w' is exact at x = 0 and x = w': the border stays the border.
-        for v in &mut mesh.vertices {
-            *v = [v[0] * w / cw, v[1] * h / ch];
+        let scale = |v: &mut [f64; 2]| *v = [v[0] * w / cw, v[1] * h / ch];
+        mesh.vertices.iter_mut().for_each(scale);
+        // The stage pictures too: drawn over the image's frame, on the reduced labels stretched
+        // to it (the cells are what was meshed).
+        for stage in &mut result.stages {
+            stage.vertices.iter_mut().for_each(scale);
+            stage.lines.iter_mut().flatten().for_each(scale);
         }
         let counts = &mut result.report.counts;
         (counts.grid_width, counts.grid_height) = (mesh.width, mesh.height);

@@ -204,11 +204,26 @@ fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     let image = image::open(&path)
         .expect("the camera fixture loads")
         .resize_exact(1300, 1100, image::imageops::FilterType::Triangle);
+    let result = Pipeline::new(MeshOptions::default())
+        .with_stages()
+        .run_image(&image)
+        .unwrap();
+    let (mesh, reduced) = (result.mesh, result.report);
+    // The stage pictures are scaled onto the image's frame too: each spans it.
+    for stage in &result.stages {
+        let xs = stage
+            .vertices
+            .iter()
+            .map(|v| v[0])
+            .chain(stage.lines.iter().flatten().map(|p| p[0]));
+        let (lo, hi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+        assert!(lo >= 0.0 && hi <= 1300.0, "{}: {lo}..{hi}", stage.name);
+        assert!(hi > 1290.0, "{}: up to {hi}", stage.name);
+    }
     let run = |options: MeshOptions| {
         let result = Pipeline::new(options).run_image(&image).unwrap();
         (result.mesh, result.report)
     };
-    let (mesh, reduced) = run(MeshOptions::default());
     let (_, pixels) = run(MeshOptions {
         reduction: Some(1),
         ..Default::default()
