@@ -287,7 +287,7 @@ pub struct MeshOptions {
     /// Mesh a reduced label grid whose every cell is the most frequent label of about
     /// `F × F` pixels ([`imesh_classify::reduce`]), then scale the mesh back onto the image:
     /// `None` (auto) reduces a uniform quad mesh of automatic size when its quads would be
-    /// at least [`AUTO_REDUCTION_SIZE`] pixels wide twice over (a large image), `Some(1)` never.
+    /// at least twice [`AUTO_REDUCTION_SIZE`] pixels wide (a large image), `Some(1)` never.
     /// The reduced grid is meshed as an image of its own: the options in pixels (size,
     /// tolerance, majority, min-width, min-region, max-size) count its cells.
     pub reduction: Option<u32>,

@@ -143,3 +143,39 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Reduced grids: whatever the factor and the crop's sizes (divisible or not), the mesh of
+    /// the cells lands on the crop's own frame, valid, with the crop's area.
+    #[test]
+    fn a_reduced_grid_gives_a_valid_mesh_of_the_image(
+        fixture in 0usize..10,
+        (fx, fy) in (0.0..1.0f64, 0.0..1.0f64),
+        (w, h) in (20u32..120, 20u32..120),
+        factor in 2u32..6,
+        size in prop::sample::select(vec![ElementSize::Auto, ElementSize::Graded, ElementSize::Pixels(3.0)]),
+        elements in prop::sample::select(vec![Elements::Quad, Elements::Quad, Elements::Tri]),
+    ) {
+        let all = grids();
+        let (name, grid) = &all[fixture % all.len()];
+        let grid = crop(grid, fx, fy, w, h);
+        let options = MeshOptions { reduction: Some(factor), size, elements, ..MeshOptions::default() };
+        let result = Pipeline::new(options.clone())
+            .run_grid(&grid, 0.0)
+            .map_err(|e| TestCaseError::fail(format!("{name} {w}×{h}: {e} with {options:?}")))?;
+        let r = &result.report;
+        let (gw, gh) = (grid.width(), grid.height());
+        prop_assert!(r.validation.valid);
+        prop_assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "area {}", r.validation.area_ratio);
+        prop_assert!(r.quality.scaled_jacobian().min > 0.0, "an inverted element");
+        prop_assert_eq!((result.mesh.width, result.mesh.height), (gw, gh));
+        prop_assert_eq!(r.counts.reduction, factor);
+        let cells = |n: u32| ((n + factor / 2) / factor).max(1);
+        prop_assert_eq!((r.counts.grid_width, r.counts.grid_height), (cells(gw), cells(gh)));
+        let inside = |v: &[f64; 2]| (0.0..=f64::from(gw)).contains(&v[0]) && (0.0..=f64::from(gh)).contains(&v[1]);
+        prop_assert!(result.mesh.vertices.iter().all(inside));
+        prop_assert!(r.label_agreement > 0.3, "agreement {}", r.label_agreement);
+    }
+}
