@@ -49,8 +49,8 @@ pub use graph::{CurveGraph, Face, GraphEdge};
 pub use grid::SegmentIndex;
 pub use polyline::{polylines, Polyline};
 pub use simplify::{
-    neck_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE, MERGE_SPAN,
-    NECK_RATIO, WEDGE_ANGLE_DEG,
+    neck_vertices, sharp_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
+    MERGE_SPAN, NECK_RATIO, SHARP_GAIN_DEG, SHARP_SECTOR_DEG, WEDGE_ANGLE_DEG,
 };
 
 /// Errors of the curve stage.

@@ -670,6 +670,103 @@ pub const NECK_RATIO: f64 = 1.5;
 /// 0.067, nothing else lower; at 20° pyvista's fell 0.275 → 0.24.
 pub const WEDGE_ANGLE_DEG: f64 = 10.0;
 
+/// Two consecutive simplified edges at a vertex closer than this angle (degrees) make a sharp
+/// sector that [`sharp_vertices`] tries to widen: a quad's corner there can be no wider, and the
+/// scaled Jacobian is its sine.
+pub const SHARP_SECTOR_DEG: f64 = 25.0;
+
+/// How much wider (degrees) the boundary's own directions must leave a sharp sector than the
+/// simplified edges do for [`sharp_vertices`] to keep them.
+pub const SHARP_GAIN_DEG: f64 = 5.0;
+
+/// The vertices of `g` that widen the sharp sectors simplification made: where two consecutive
+/// edges of G' (`s`, the simplification of `g`) leave a vertex less than [`SHARP_SECTOR_DEG`]
+/// apart, the first inner vertex of each one's chain at least `length` from it, when the
+/// directions to those vertices open the sector by [`SHARP_GAIN_DEG`] or more. A long chord
+/// from the tip of a spike, or from a junction, runs nearly along its neighbour though the
+/// boundaries leave the vertex wider apart; pinned (see [`CurveGraph::pin`]) and simplified again,
+/// the first piece of each follows its boundary's direction. Where the image itself is that
+/// sharp, nothing is kept.
+///
+/// ```
+/// use imesh_curves::{sharp_vertices, simplify, CurveGraph, GraphEdge, SimplifyOptions};
+/// use imesh_geom::Point;
+/// // A spike 2 px wide with a blunt tip at (0, 0), its sides from (3, ±1) to (30, ±1).
+/// let p = Point::new;
+/// let points = vec![p(0.0, 0.0), p(3.0, 1.0), p(30.0, 1.0), p(3.0, -1.0), p(30.0, -1.0)];
+/// let e = |a, b| GraphEdge { ends: [a, b], labels: [1, 0] };
+/// let mut g = CurveGraph::new(points, vec![e(0, 1), e(1, 2), e(4, 3), e(3, 0), e(2, 4)])?;
+/// g.pin(0)?;
+/// let options = SimplifyOptions::with_tolerance(1.5);
+/// let s = simplify(&g, &options)?;
+/// // Simplified: 0–2 (over 1), 2–4, 4–3, 3–0. At the tip, the chord to (30, 1) runs 20.3° from
+/// // the edge to (3, −1); the boundary through (3, 1) leaves it 36.9° from it.
+/// assert_eq!(s.chains[0], [0, 1, 2]);
+/// assert_eq!(sharp_vertices(&g, &s, 3.0), [1]);
+/// g.pin(1)?;
+/// // Simplified again, the other side's chord 0–4 (over 3) now runs 20.3° from 0–1.
+/// let s = simplify(&g, &options)?;
+/// assert_eq!(sharp_vertices(&g, &s, 3.0), [3]);
+/// g.pin(3)?;
+/// assert!(sharp_vertices(&g, &simplify(&g, &options)?, 3.0).is_empty());
+/// # Ok::<(), imesh_curves::CurveError>(())
+/// ```
+pub fn sharp_vertices(g: &CurveGraph, s: &Simplification, length: f64) -> Vec<u32> {
+    let gs = &s.graph;
+    if !(length.is_finite() && length > 0.0) {
+        return Vec::new();
+    }
+    let sharp = SHARP_SECTOR_DEG.to_radians();
+    let gain = SHARP_GAIN_DEG.to_radians();
+    let angle = |d: Point| d.y.atan2(d.x);
+    // The angle from direction a to direction b, counter-clockwise, in [0, 2π).
+    let turn = |a: f64, b: f64| (b - a).rem_euclid(std::f64::consts::TAU);
+    let mut found = Vec::new();
+    for v in 0..gs.points().len() as u32 {
+        let incident = gs.incident(v);
+        if incident.len() < 2 {
+            continue;
+        }
+        let p = gs.point(v);
+        // Each edge leaving v: its chord's angle, and its boundary's first vertex `length` away.
+        let mut around: Vec<(f64, Option<u32>, f64)> = incident
+            .iter()
+            .map(|&e| {
+                let chain = &s.chains[e as usize];
+                let from_v = chain.first() == Some(&v);
+                let far = if from_v { chain.last() } else { chain.first() };
+                let chord = angle(gs.point(*far.unwrap_or(&v)) - p);
+                let inner = chain.get(1..chain.len().saturating_sub(1)).unwrap_or(&[]);
+                let reach = |&w: &u32| g.point(w).distance_squared(p) >= length * length;
+                let first = if from_v {
+                    inner.iter().find(|w| reach(w))
+                } else {
+                    inner.iter().rev().find(|w| reach(w))
+                };
+                let local = first.map_or(chord, |&w| angle(g.point(w) - p));
+                (chord, first.copied(), local)
+            })
+            .collect();
+        around.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let n = around.len();
+        for i in 0..n {
+            let (a, b) = (around[i], around[(i + 1) % n]);
+            let sector = turn(a.0, b.0);
+            if sector >= sharp || (a.1.is_none() && b.1.is_none()) {
+                continue;
+            }
+            // The boundaries' own directions, the sector measured the same way round.
+            let wider = turn(a.2, b.2);
+            if wider >= sector + gain && wider < std::f64::consts::PI {
+                found.extend(a.1.into_iter().chain(b.1));
+            }
+        }
+    }
+    found.sort_unstable();
+    found.dedup();
+    found
+}
+
 /// The vertices of `g` that undo the necks simplification made: where an edge of G' (`s`, the
 /// simplification of `g`) passes closer than `min_width` to a vertex of G' that is neither one
 /// of its ends nor joined to one (unless the joining edge leaves that end at less than

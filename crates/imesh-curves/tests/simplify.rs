@@ -3,9 +3,9 @@
 mod support;
 
 use imesh_curves::{
-    contract_short_links, fit_edges, neck_vertices, polylines, segment_distance, simplify,
-    CurveError, CurveGraph, FitOptions, GraphEdge, SegmentIndex, Simplification, SimplifyOptions,
-    DEFAULT_TOLERANCE,
+    contract_short_links, fit_edges, neck_vertices, polylines, segment_distance, sharp_vertices,
+    simplify, CurveError, CurveGraph, FitOptions, GraphEdge, SegmentIndex, Simplification,
+    SimplifyOptions, DEFAULT_TOLERANCE,
 };
 use imesh_geom::Point;
 use proptest::prelude::*;
@@ -591,6 +591,75 @@ proptest! {
             }
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The vertices kept at sharp sectors are inner chain vertices not yet in G'; pinned, the
+    /// graph simplifies with its topology kept and each of them is a vertex of the new G', and
+    /// no sector the boundaries leave wider stays sharper than they.
+    #[test]
+    fn vertices_kept_at_sharp_sectors_keep_the_topology((w, h, labels) in label_image()) {
+        let mut g = support::imesh_boundaries(&support::grid(w, h, labels));
+        for (tolerance, length) in [(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)] {
+            let options = SimplifyOptions::with_tolerance(tolerance);
+            let s = simplify(&g, &options).unwrap();
+            let sharp = sharp_vertices(&g, &s, length);
+            for &v in &sharp {
+                let inner = s.chains.iter().any(|c| c.len() > 2 && c[1..c.len() - 1].contains(&v));
+                prop_assert!(inner, "vertex {} is not inside a chain", v);
+                prop_assert!(s.graph.valence(v) == 0, "vertex {} is already in G'", v);
+                prop_assert!(s.graph.point(v) == g.point(v));
+            }
+            for &v in &sharp {
+                g.pin(v).unwrap();
+            }
+            let again = simplify(&g, &options).unwrap();
+            check_simplification(&g, &again, tolerance);
+            for &v in &sharp {
+                prop_assert!(again.graph.valence(v) > 0, "pinned vertex {} left G'", v);
+            }
+        }
+    }
+}
+
+/// A spike whose sides run straight from its tip is as sharp in the image as in G': nothing
+/// to keep. One whose sides leave the tip wider and then run parallel keeps a vertex.
+#[test]
+fn a_sharp_sector_is_widened_only_where_the_boundary_is_wider() {
+    let p = Point::new;
+    let spike = |side: [Point; 2]| -> Result<Vec<u32>, imesh_curves::CurveError> {
+        // The tip 0, a side 0–1–2 and its mirror 0–3–4, closed by 2–4.
+        let mirror = |q: Point| p(q.x, -q.y);
+        let points = vec![
+            p(0.0, 0.0),
+            side[0],
+            side[1],
+            mirror(side[0]),
+            mirror(side[1]),
+        ];
+        let edges = vec![
+            edge(0, 1, [1, 0]),
+            edge(1, 2, [1, 0]),
+            edge(2, 4, [1, 0]),
+            edge(4, 3, [1, 0]),
+            edge(3, 0, [1, 0]),
+        ];
+        let mut g = CurveGraph::new(points, edges)?;
+        g.pin(0)?;
+        let s = simplify(&g, &SimplifyOptions::with_tolerance(1.5))?;
+        Ok(sharp_vertices(&g, &s, 2.0))
+    };
+    // Straight sides 10° apart: the chords are the boundary.
+    let a = 5f64.to_radians();
+    let straight = [
+        p(10.0 * a.cos(), 10.0 * a.sin()),
+        p(30.0 * a.cos(), 30.0 * a.sin()),
+    ];
+    assert!(spike(straight).unwrap().is_empty());
+    // A blunt tip: sides leave 37° apart, then run 2 px apart.
+    assert!(!spike([p(3.0, 1.0), p(30.0, 1.0)]).unwrap().is_empty());
 }
 
 /// A thin wedge at a junction: an edge whose chord passes 0.2 px from the far end of another
