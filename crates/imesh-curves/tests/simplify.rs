@@ -563,64 +563,54 @@ fn a_short_piece_is_joined_with_a_neighbour() {
     assert!(ends.iter().any(|e| e.contains(&0)) && ends.iter().any(|e| e.contains(&3)));
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
-
-    /// The vertices kept at necks are inner vertices of the chains of G' edges that pass near
-    /// another G' vertex, farther from it than the edge; pinned, the graph
-    /// simplifies with its topology kept, and each of them is a vertex of the new G'.
-    #[test]
-    fn vertices_kept_at_necks_keep_the_topology((w, h, labels) in label_image()) {
-        let mut g = support::imesh_boundaries(&support::grid(w, h, labels));
-        for (tolerance, min_width) in [(1.0, 0.5), (2.0, 1.0), (3.0, 2.0)] {
-            let options = SimplifyOptions::with_tolerance(tolerance);
-            let s = simplify(&g, &options).unwrap();
-            let necks = neck_vertices(&g, &s, min_width);
-            for &v in &necks {
-                let inner = s.chains.iter().any(|c| c.len() > 2 && c[1..c.len() - 1].contains(&v));
-                prop_assert!(inner, "vertex {} is not inside a chain", v);
-                prop_assert!(s.graph.valence(v) == 0, "vertex {} is already in G'", v);
-            }
-            for &v in &necks {
-                g.pin(v).unwrap();
-            }
-            let again = simplify(&g, &options).unwrap();
-            check_simplification(&g, &again, tolerance);
-            for &v in &necks {
-                prop_assert!(again.graph.valence(v) > 0, "pinned vertex {} left G'", v);
-            }
+/// Simplifies `g` at each `(tolerance, parameter)` of `runs` and pins the vertices `pick`
+/// chooses there: each must be an inner vertex of a chain, not yet in G'; pinned, the graph
+/// simplifies again with its topology kept, and each of them is a vertex of the new G'.
+fn pinned_vertices_keep_the_topology(
+    mut g: CurveGraph,
+    runs: [(f64, f64); 3],
+    pick: impl Fn(&CurveGraph, &Simplification, f64) -> Vec<u32>,
+) -> Result<(), TestCaseError> {
+    for (tolerance, parameter) in runs {
+        let options = SimplifyOptions::with_tolerance(tolerance);
+        let s = simplify(&g, &options).unwrap();
+        let picked = pick(&g, &s, parameter);
+        for &v in &picked {
+            let inner = s
+                .chains
+                .iter()
+                .any(|c| c.len() > 2 && c[1..c.len() - 1].contains(&v));
+            prop_assert!(inner, "vertex {} is not inside a chain", v);
+            prop_assert!(s.graph.valence(v) == 0, "vertex {} is already in G'", v);
+        }
+        for &v in &picked {
+            g.pin(v).unwrap();
+        }
+        let again = simplify(&g, &options).unwrap();
+        check_simplification(&g, &again, tolerance);
+        for &v in &picked {
+            prop_assert!(again.graph.valence(v) > 0, "pinned vertex {} left G'", v);
         }
     }
+    Ok(())
 }
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
-    /// The vertices kept at sharp sectors are inner chain vertices not yet in G'; pinned, the
-    /// graph simplifies with its topology kept and each of them is a vertex of the new G', and
-    /// no sector the boundaries leave wider stays sharper than they.
+    /// The vertices kept at necks (chain vertices of G' edges that pass near another G'
+    /// vertex, farther from it than the edge) keep the topology.
+    #[test]
+    fn vertices_kept_at_necks_keep_the_topology((w, h, labels) in label_image()) {
+        let g = support::imesh_boundaries(&support::grid(w, h, labels));
+        pinned_vertices_keep_the_topology(g, [(1.0, 0.5), (2.0, 1.0), (3.0, 2.0)], neck_vertices)?;
+    }
+
+    /// So do the vertices kept at sharp sectors.
     #[test]
     fn vertices_kept_at_sharp_sectors_keep_the_topology((w, h, labels) in label_image()) {
-        let mut g = support::imesh_boundaries(&support::grid(w, h, labels));
-        for (tolerance, length) in [(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)] {
-            let options = SimplifyOptions::with_tolerance(tolerance);
-            let s = simplify(&g, &options).unwrap();
-            let sharp = sharp_vertices(&g, &s, length);
-            for &v in &sharp {
-                let inner = s.chains.iter().any(|c| c.len() > 2 && c[1..c.len() - 1].contains(&v));
-                prop_assert!(inner, "vertex {} is not inside a chain", v);
-                prop_assert!(s.graph.valence(v) == 0, "vertex {} is already in G'", v);
-                prop_assert!(s.graph.point(v) == g.point(v));
-            }
-            for &v in &sharp {
-                g.pin(v).unwrap();
-            }
-            let again = simplify(&g, &options).unwrap();
-            check_simplification(&g, &again, tolerance);
-            for &v in &sharp {
-                prop_assert!(again.graph.valence(v) > 0, "pinned vertex {} left G'", v);
-            }
-        }
+        let g = support::imesh_boundaries(&support::grid(w, h, labels));
+        pinned_vertices_keep_the_topology(g, [(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)], sharp_vertices)?;
     }
 }
 
