@@ -1751,29 +1751,16 @@ pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
 
 /// The quality statistics of `mesh`'s quads, or of its triangles.
 fn mesh_quality(mesh: &SegmentedMeshData, elements: Elements) -> MeshQuality {
+    let (mut triangles, mut quads) = (Vec::new(), Vec::new());
+    for element in &mesh.elements {
+        match *element {
+            Element::Triangle(t) => triangles.push(t),
+            Element::Quad(q) => quads.push(q),
+        }
+    }
     match elements {
-        Elements::Tri => {
-            let triangles: Vec<[u32; 3]> = mesh
-                .elements
-                .iter()
-                .filter_map(|e| match e {
-                    Element::Triangle(t) => Some(*t),
-                    Element::Quad(_) => None,
-                })
-                .collect();
-            MeshQuality::Triangles(TriangleQuality::of(&mesh.vertices, &triangles))
-        }
-        Elements::Quad => {
-            let quads: Vec<[u32; 4]> = mesh
-                .elements
-                .iter()
-                .filter_map(|e| match e {
-                    Element::Quad(q) => Some(*q),
-                    Element::Triangle(_) => None,
-                })
-                .collect();
-            MeshQuality::Quads(QuadQuality::of(&mesh.vertices, &quads))
-        }
+        Elements::Tri => MeshQuality::Triangles(TriangleQuality::of(&mesh.vertices, &triangles)),
+        Elements::Quad => MeshQuality::Quads(QuadQuality::of(&mesh.vertices, &quads)),
     }
 }
 
