@@ -380,7 +380,7 @@ pub fn pipeline(data: &[u8]) {
     let mut b = Bytes::new(data);
     let options = MeshOptions {
         te: b.pick(&[0.05, 0.1, 0.3, 0.6]),
-        tolerance: b.pick(&[0.0, 0.5, 2.0, 5.0, 15.0]),
+        tolerance: b.pick(&[Some(0.0), Some(0.5), Some(2.0), Some(5.0), Some(15.0)]),
         min_angle: b.pick(&[None, Some(10.0), Some(20.7), Some(28.0), Some(33.0)]),
         max_size: b.pick(&[None, None, Some(1.5), Some(4.0), Some(12.0)]),
         template_level: b.pick(&[1, 1, 2, 3]),

@@ -90,8 +90,9 @@ pub enum ElementSize {
 /// of up to 32 labels, (2R+1)² on others.
 pub const MAX_MAJORITY: u32 = 8;
 
-/// Automatic reduction ([`MeshOptions::reduction`]): an image whose automatic quad side is
-/// `q` pixels is meshed on cells of `F = ⌊q / AUTO_REDUCTION_SIZE⌋` pixels when `F ≥ 2`, so
+/// Automatic reduction ([`MeshOptions::reduction`]): an image whose uniform quads (of
+/// automatic size, or of the size given) are `q` pixels wide is meshed on cells of
+/// `F = ⌊q / AUTO_REDUCTION_SIZE⌋` pixels when `F ≥ 2`, so
 /// that its quads are 4 to 8 cells wide: the size at which the defaults (curve tolerance,
 /// majority filter, minimum width) were tuned and mesh best. Measured on the camera fixture
 /// resized to 4096² (quads 41 pixels wide): mean shape-and-size 0.66 and worst scaled Jacobian
@@ -295,13 +296,15 @@ pub struct MeshOptions {
     pub majority: Option<u32>,
     /// Mesh a reduced label grid whose every cell is the most frequent label of about
     /// `F × F` pixels ([`imesh_classify::reduce`]), then scale the mesh back onto the image:
-    /// `None` (auto) reduces a uniform quad mesh of automatic size when its quads would be
-    /// at least twice [`AUTO_REDUCTION_SIZE`] pixels wide (a large image), `Some(1)` never.
-    /// The reduced grid is meshed as an image of its own: the options in pixels (size,
-    /// tolerance, majority, min-width, min-region, max-size) count its cells.
+    /// `None` (auto) reduces a uniform quad mesh whose quads (of automatic size, or of the size
+    /// given) would be at least twice [`AUTO_REDUCTION_SIZE`] pixels wide, `Some(1)` never.
+    /// The options given in pixels (size, tolerance, majority, min-width, min-region, max-size)
+    /// are converted to cells; the defaults apply to the cells as to pixels (the curve
+    /// tolerance is then 2 cells).
     pub reduction: Option<u32>,
-    /// Curve simplification tolerance in pixels (quads).
-    pub tolerance: f64,
+    /// Curve simplification tolerance in pixels (quads); `None`:
+    /// [`imesh_curves::DEFAULT_TOLERANCE`] pixels, or that many cells of a reduced grid.
+    pub tolerance: Option<f64>,
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² (1–8).
     pub template_level: u32,
     /// How triangles are paired into quads.
@@ -342,7 +345,7 @@ impl Default for MeshOptions {
             min_region: 0,
             majority: None,
             reduction: None,
-            tolerance: imesh_curves::DEFAULT_TOLERANCE,
+            tolerance: None,
             template_level: 1,
             pairing: PairingMethod::Matching,
             elements: Elements::Quad,
@@ -864,7 +867,15 @@ impl Pipeline {
             return self.mesh_grid(grid, classified);
         };
         let reducing = start.elapsed().as_secs_f64();
-        let mut result = self.mesh_grid(&reduced, classified + reducing)?;
+        let (sx, sy) = (
+            f64::from(grid.width()) / f64::from(reduced.width()),
+            f64::from(grid.height()) / f64::from(reduced.height()),
+        );
+        let on_cells = Pipeline {
+            options: self.options.in_cells(sx, sy),
+            ..self.clone()
+        };
+        let mut result = on_cells.mesh_grid(&reduced, classified + reducing)?;
         self.enlarge(&mut result, grid, factor)?;
         result.report.seconds.total = classified + start.elapsed().as_secs_f64();
         Ok(result)
@@ -890,6 +901,7 @@ impl Pipeline {
         let factor = |q: f64| (q / AUTO_REDUCTION_SIZE).floor().clamp(0.0, 1e9) as u32;
         match (o.reduction, o.size, o.elements) {
             (Some(f), _, _) => reduce(f),
+            (None, ElementSize::Pixels(px), Elements::Quad) => reduce(factor(px)),
             (None, ElementSize::Auto, Elements::Quad) => {
                 let by_count = (f64::from(w) * f64::from(h) / AUTO_QUADS).sqrt();
                 let (bound, first) = reduce(factor(by_count))?;
@@ -936,6 +948,12 @@ impl Pipeline {
         counts.dt_spacing *= sx;
         counts.merged_area *= sx * sy;
         let report = &mut result.report;
+        // The options as given, the tolerance as used (in pixels).
+        let tolerance = report.options.tolerance.map(|t| t * (sx * sy).sqrt());
+        report.options = MeshOptions {
+            tolerance,
+            ..self.options.clone()
+        };
         report.input.width = original.width();
         report.input.height = original.height();
         report.fidelity.boundary_hausdorff_px *= sx.max(sy);
@@ -1121,7 +1139,10 @@ impl Pipeline {
         seconds.check = check.elapsed().as_secs_f64();
         seconds.total = classified + start.elapsed().as_secs_f64();
         let report = Report {
-            options: o.clone(),
+            options: MeshOptions {
+                tolerance: Some(self.tolerance()),
+                ..o.clone()
+            },
             counts,
             seconds,
             imesh_version: env!("CARGO_PKG_VERSION"),
@@ -1198,7 +1219,6 @@ impl Pipeline {
         height: u32,
         quad_size: Option<f64>,
     ) -> Result<Curves, PipelineError> {
-        let o = &self.options;
         let g = graph_of_c_edges(t, &c_edges(t, label), width, height)?;
         let (g, contracted) = match quad_size {
             // Junctions closer than a fraction of a quad (four regions meeting at a pixel
@@ -1207,7 +1227,7 @@ impl Pipeline {
                 let c = contract_short_links(
                     &g,
                     LINK_SHARE * q,
-                    o.tolerance,
+                    self.tolerance(),
                     f64::from(width),
                     f64::from(height),
                 )?;
@@ -1225,11 +1245,18 @@ impl Pipeline {
         })
     }
 
+    /// The curve tolerance in pixels of the grid meshed.
+    fn tolerance(&self) -> f64 {
+        self.options
+            .tolerance
+            .unwrap_or(imesh_curves::DEFAULT_TOLERANCE)
+    }
+
     /// The simplification options: the tolerance, and pieces of at least a quad side (uniform
     /// quads).
     fn simplify_options(&self, quad_size: Option<f64>) -> SimplifyOptions {
         SimplifyOptions {
-            tolerance: self.options.tolerance,
+            tolerance: self.tolerance(),
             min_length: quad_size.map_or(0.0, |q| MIN_PIECE * q),
         }
     }
@@ -1577,10 +1604,9 @@ impl Pipeline {
                  region), not {w}"
             )));
         }
-        if !(o.tolerance.is_finite() && o.tolerance >= 0.0) {
+        if let Some(t) = o.tolerance.filter(|t| !(t.is_finite() && *t >= 0.0)) {
             return Err(PipelineError::Options(format!(
-                "the curve tolerance must be a distance in pixels ≥ 0, not {}",
-                o.tolerance
+                "the curve tolerance must be a distance in pixels ≥ 0, not {t}"
             )));
         }
         if let Some(s) = o.max_size {
@@ -1600,6 +1626,27 @@ impl Pipeline {
             )));
         }
         Ok(())
+    }
+}
+
+impl MeshOptions {
+    /// These options for a grid of cells `sx × sy` pixels each ([`MeshOptions::reduction`]):
+    /// the lengths and areas given in pixels become cells; the defaults stay, so that they
+    /// scale with the cells (the 2-pixel curve tolerance becomes 2 cells).
+    fn in_cells(&self, sx: f64, sy: f64) -> MeshOptions {
+        let s = (sx * sy).sqrt();
+        MeshOptions {
+            size: match self.size {
+                ElementSize::Pixels(px) => ElementSize::Pixels(px / s),
+                other => other,
+            },
+            tolerance: self.tolerance.map(|t| t / s),
+            majority: self.majority.map(|r| (f64::from(r) / s).round() as u32),
+            min_width: self.min_width.map(|w| w / s),
+            min_region: (self.min_region as f64 / (sx * sy)).ceil() as usize,
+            max_size: self.max_size.map(|m| m / s),
+            ..self.clone()
+        }
     }
 }
 
@@ -1911,6 +1958,6 @@ mod tests {
         assert!(c.necks > 0, "pyvista has necks");
         assert!(neck_vertices(&c.g, &c.simplified, NECK_SHARE * q).is_empty());
         // Still within the tolerance of the image's boundaries.
-        assert!(c.simplified.max_deviation <= pipeline.options.tolerance);
+        assert!(c.simplified.max_deviation <= pipeline.tolerance());
     }
 }

@@ -145,12 +145,12 @@ struct MeshFlags {
     #[arg(long)]
     min_width: Option<AutoOr<f64>>,
     /// Mesh a reduced grid whose cells are the most common label of about F × F pixels, then
-    /// scale the mesh back: auto (uniform quads of automatic size over 8 px wide, i.e. large
-    /// images: F makes them 4 to 8 cells wide), 1 (never) or F. The options in pixels then
-    /// count cells [default: auto].
+    /// scale the mesh back: auto (uniform quads 8 px wide or more, e.g. a large image or a
+    /// large --size: F makes them 4 to 8 cells wide), 1 (never) or F. Options given in pixels
+    /// are converted to cells [default: auto].
     #[arg(long)]
     reduction: Option<AutoOr<u32>>,
-    /// Curve simplification tolerance in pixels [default: 2].
+    /// Curve simplification tolerance in pixels [default: 2, or 2 cells of a reduced grid].
     #[arg(long)]
     tolerance: Option<f64>,
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² [default: 1].
@@ -259,7 +259,7 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
         o.min_angle = Some(a);
     }
     if let Some(t) = args.tolerance {
-        o.tolerance = t;
+        o.tolerance = Some(t);
     }
     if let Some(k) = args.template_level {
         o.template_level = k;

@@ -15,11 +15,11 @@ fn degenerate_images_give_valid_all_quad_meshes() {
             ..Default::default()
         },
         MeshOptions {
-            tolerance: 0.0,
+            tolerance: Some(0.0),
             ..Default::default()
         },
         MeshOptions {
-            tolerance: 15.0,
+            tolerance: Some(15.0),
             max_size: Some(3.0),
             ..Default::default()
         },
@@ -284,4 +284,44 @@ fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     assert!(sns(&reduced) > sns(&pixels));
     assert!(sns(&reduced) > 0.85);
     assert!(sj(&reduced) > 0.3);
+    // A size given in pixels reduces too (⌊12 / 4⌋ = 3), and is kept in pixels.
+    let (_, given) = run(MeshOptions {
+        size: ElementSize::Pixels(12.0),
+        ..Default::default()
+    });
+    assert_eq!(given.counts.reduction, 3);
+    assert!((given.counts.quad_size / 12.0 - 1.0).abs() < 0.01);
+    assert_eq!(given.options.size, ElementSize::Pixels(12.0));
+    assert!(given.validation.valid && sns(&given) > 0.85);
+}
+
+/// Under a reduction the options given in pixels are converted to cells, the defaults apply to
+/// the cells: a 2 px tolerance keeps the boundaries within 2 px of the image's, the default
+/// within 2 cells. (Graded: no quad-sized joining of short pieces, so the tolerance is the
+/// bound.)
+#[test]
+fn options_given_in_pixels_stay_in_pixels_on_a_reduced_grid() {
+    let path = support::fixtures()
+        .into_iter()
+        .find(|p| p.ends_with("stardist-mask2d_labels.png"))
+        .expect("the stardist fixture");
+    let run = |tolerance: Option<f64>| {
+        let options = MeshOptions {
+            size: ElementSize::Graded,
+            reduction: Some(4),
+            tolerance,
+            ..Default::default()
+        };
+        Pipeline::new(options).run_path(&path).unwrap().report
+    };
+    let given = run(Some(2.0));
+    let default = run(None);
+    let hausdorff = |r: &imesh::Report| r.fidelity.boundary_hausdorff_px;
+    assert_eq!(given.counts.reduction, 4);
+    assert_eq!(given.options.tolerance, Some(2.0));
+    assert!(hausdorff(&given) > 0.0 && hausdorff(&given) <= 2.0 + 1e-9);
+    // The default: 2 cells of 4 px, reported as used.
+    assert_eq!(default.options.tolerance, Some(8.0));
+    assert!(hausdorff(&default) > 2.0 && hausdorff(&default) <= 8.0 + 1e-9);
+    assert!(default.counts.quads < given.counts.quads);
 }

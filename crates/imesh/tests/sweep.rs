@@ -96,7 +96,7 @@ fn options() -> impl Strategy<Value = MeshOptions> {
                     min_region,
                     majority,
                     te,
-                    tolerance,
+                    tolerance: Some(tolerance),
                     min_angle,
                     max_size,
                     template_level: level,
