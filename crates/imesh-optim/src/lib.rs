@@ -217,9 +217,10 @@ pub(crate) struct Setup<'a> {
     /// whatever the metric: sizes are never evened out by spoiling shapes.
     pub shape_floors: &'a [f64],
     /// ... and quad `q` not below scaled Jacobian `jacobian_floors[q]`: its start value where
-    /// its shape floor is its own start shape (a poor quad), `-∞` elsewhere (a shape of at least
-    /// [`OptimOptions::keep_shape`] keeps the scaled Jacobian above it: at every corner
-    /// `2α / (|a|² + |b|²) ≤ α / (|a| |b|)`). So the worst scaled Jacobian never falls.
+    /// its shape floor is its own start shape (a poor quad), the start's worst elsewhere (a
+    /// shape of at least [`OptimOptions::keep_shape`] keeps the scaled Jacobian above that: at
+    /// every corner `2α / (|a|² + |b|²) ≤ α / (|a| |b|)`, so the floor costs a Jacobian only
+    /// when the start's worst is above `keep_shape`). So the worst scaled Jacobian never falls.
     pub jacobian_floors: &'a [f64],
     pub max_sweeps: usize,
     pub tolerance: f64,
@@ -370,10 +371,12 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         .map(|q| {
             let p = q.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
             let shape = imesh_quality::quad::shape(&p);
+            // A shape of at least `keep_shape` holds the scaled Jacobian above `keep_shape`
+            // only: the start's worst can be higher (a mesh of good quads).
             let jacobian = if shape < options.keep_shape {
                 imesh_quality::quad::scaled_jacobian(&p)
             } else {
-                f64::NEG_INFINITY
+                before.scaled_jacobian.min
             };
             (
                 shape.min(options.keep_shape).max(before.shape.min),
@@ -443,13 +446,9 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         }
     };
     let sweeps = if sliding {
-        // The boundary vertices slide along their curves, and the inside follows. Moving quad
-        // vertices directly, a quad of good shape can lose a corner's angle that the control
-        // points' smoothness kept: here every quad is held to the start's worst scaled Jacobian.
-        let worst = before.scaled_jacobian.min;
-        let held: Vec<f64> = jacobian_floors.iter().map(|&f| f.max(worst)).collect();
+        // The boundary vertices slide along their curves, and the inside follows, every quad
+        // held to the same floors (the start's worst scaled Jacobian at least).
         let polish = Setup {
-            jacobian_floors: &held,
             max_sweeps: POLISH_SWEEPS,
             ..setup
         };
