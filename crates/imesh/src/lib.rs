@@ -957,16 +957,8 @@ impl Pipeline {
         report.input.width = original.width();
         report.input.height = original.height();
         report.fidelity.boundary_hausdorff_px *= sx.max(sy);
-        let view = MeshView {
-            vertices: &mesh.vertices,
-            elements: &mesh.elements,
-            labels: &mesh.labels,
-        };
-        let checked = validate(&view, &Domain::image(w, h));
-        if !checked.is_valid() {
-            return Err(PipelineError::Invalid(format!("{:?}", checked.violations)));
-        }
-        report.validation.area_ratio = checked.area / (w * h);
+        report.validation.area_ratio =
+            area_ratio(&mesh.vertices, &mesh.elements, &mesh.labels, w, h)?;
         report.quality = mesh_quality(mesh, self.options.elements);
         report.label_agreement = agreement_with_original(mesh, original);
         report.fidelity.label_agreement = report.label_agreement;
@@ -1102,17 +1094,7 @@ impl Pipeline {
         });
         let check = Instant::now();
         self.stage(Stage::Check);
-        let checked = validate(
-            &MeshView {
-                vertices: &vertices,
-                elements: &elements,
-                labels: &labels,
-            },
-            &Domain::image(f64::from(w), f64::from(h)),
-        );
-        if !checked.is_valid() {
-            return Err(PipelineError::Invalid(format!("{:?}", checked.violations)));
-        }
+        let area_ratio = area_ratio(&vertices, &elements, &labels, f64::from(w), f64::from(h))?;
         counts.vertices = vertices.len();
         counts.elements = elements.len();
         counts.quads = elements
@@ -1164,7 +1146,7 @@ impl Pipeline {
             optimisation: optimised.map(|x| x.optimisation),
             validation: Validation {
                 valid: true,
-                area_ratio: checked.area / (f64::from(w) * f64::from(h)),
+                area_ratio,
             },
         };
         Ok(PipelineResult {
@@ -1794,6 +1776,27 @@ fn equilateral_area(s: f64) -> f64 {
 /// so a centre is inside when it is on the inner side of every edge.
 pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
     agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid)
+}
+
+/// Validates a mesh on the image domain `w × h` (conforming, exact area, no inverted element,
+/// one known label per element): its area over the domain's, or the violations as an error.
+fn area_ratio(
+    vertices: &[[f64; 2]],
+    elements: &[Element],
+    labels: &[u32],
+    w: f64,
+    h: f64,
+) -> Result<f64, PipelineError> {
+    let view = MeshView {
+        vertices,
+        elements,
+        labels,
+    };
+    let checked = validate(&view, &Domain::image(w, h));
+    if !checked.is_valid() {
+        return Err(PipelineError::Invalid(format!("{:?}", checked.violations)));
+    }
+    Ok(checked.area / (w * h))
 }
 
 /// The quality statistics of `mesh`'s quads, or of its triangles.
