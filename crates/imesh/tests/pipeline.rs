@@ -205,6 +205,42 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
 }
 
 #[test]
+fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
+    let path = support::fixtures()
+        .into_iter()
+        .find(|p| p.ends_with("skimage-coins.png"))
+        .expect("the coins fixture");
+    let run = |options: MeshOptions| Pipeline::new(options).run_path(&path).unwrap().report;
+    let auto = run(MeshOptions::default());
+    // The size from the quad count alone (coins' regions are wide): the clean-ups' size, and
+    // the mesh's before the boundaries were measured.
+    let by_count = (384.0 * 303.0 / imesh::AUTO_QUADS).sqrt();
+    let coarse = run(MeshOptions {
+        size: ElementSize::Pixels(by_count),
+        ..Default::default()
+    });
+    let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
+    eprintln!(
+        "coins: auto {:.2} px, {} quads, mean S&S {:.4}; {by_count:.2} px: {} quads, {:.4}",
+        auto.counts.quad_size,
+        auto.counts.quads,
+        mean(&auto),
+        coarse.counts.quads,
+        mean(&coarse)
+    );
+    assert!(auto.validation.valid && coarse.validation.valid);
+    assert!(auto.counts.quad_size < 0.9 * by_count);
+    assert!(auto.counts.quad_size >= by_count / imesh::AUTO_BAND_REFINEMENT - 1e-9);
+    // The same clean-up (majority filter, thin regions) at both sizes.
+    assert_eq!(auto.counts.cleaned_pixels, coarse.counts.cleaned_pixels);
+    assert_eq!(auto.counts.merged_regions, coarse.counts.merged_regions);
+    assert!(auto.counts.quads > coarse.counts.quads);
+    // The paper's Table I mean, which the coarser mesh misses.
+    assert!(mean(&auto) >= 0.85, "default mean {:.4}", mean(&auto));
+    assert!(mean(&auto) > mean(&coarse) + 0.02);
+}
+
+#[test]
 fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     let path = support::fixtures()
         .into_iter()
