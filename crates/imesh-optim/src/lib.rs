@@ -50,6 +50,7 @@ mod global;
 mod laplacian;
 mod local;
 mod powell;
+mod repair;
 mod slide;
 mod variables;
 
@@ -57,6 +58,7 @@ pub use energy::{is_valid, Metric};
 
 use energy::worst_corner;
 pub use powell::Powell;
+pub use repair::REPAIR_JACOBIAN;
 
 use std::time::Instant;
 
@@ -141,6 +143,15 @@ pub struct OptimOptions {
     /// mode, so that the inside follows. The control points keep the spacing DT' gave each
     /// boundary; this frees it. Measured on the fixtures: mean shape-and-size +0.004 to +0.03.
     pub slide: bool,
+    /// After the local or the vertex mode (and the sliding): every free quad vertex within two
+    /// rings of a quad whose scaled Jacobian is under [`REPAIR_JACOBIAN`] moves, by compass
+    /// search, to raise the smallest scaled Jacobian of its quads (up to that bar), every quad
+    /// held to the same floors; undone if it would leave the energy above the start's. The
+    /// energy leaves such quads where their shape-and-size is fair. Measured with the defaults:
+    /// worst scaled Jacobian stardist 0.272 → 0.355, coffee 0.251 → 0.280, grass 0.280 →
+    /// 0.299, MRI 0.352 → 0.371, camera 0.358 → 0.383, the other four equal; mean
+    /// shape-and-size within 0.0005; about 1 % of the optimiser's time.
+    pub repair: bool,
 }
 
 impl Default for OptimOptions {
@@ -156,6 +167,7 @@ impl Default for OptimOptions {
             keep_shape: 0.5,
             settled: 0.95,
             slide: true,
+            repair: true,
         }
     }
 }
@@ -196,6 +208,8 @@ pub struct OptimReport {
     pub sweeps: usize,
     /// Quad vertices that slid along the boundary curves ([`OptimOptions::slide`]).
     pub sliders: usize,
+    /// Quad vertices moved to raise the worst scaled Jacobians ([`OptimOptions::repair`]).
+    pub repaired: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
     /// Quality before.
@@ -462,6 +476,21 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     } else {
         sweeps
     };
+    let repaired = if options.repair && matches!(options.method, Method::Local | Method::Vertex) {
+        let vars = Variables::vertices(t, elements, mesh);
+        let descended = mesh.vertices.clone();
+        let moved = repair::repair(&vars, &mut mesh.vertices, &setup, REPAIR_JACOBIAN);
+        // Repair trades energy for corners; it never takes back more than the descent gained
+        // (on the fixtures it costs 0.0005 of mean shape-and-size at most).
+        if moved > 0 && setup.energy(&mesh.vertices) > energy_before {
+            mesh.vertices = descended;
+            0
+        } else {
+            moved
+        }
+    } else {
+        0
+    };
     // Sliding re-evaluates boundary vertices on their curves, the border's too.
     mesh.snap_to_border(t, elements);
     let energy_after = setup.energy(&mesh.vertices);
@@ -476,6 +505,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         energy_after,
         sweeps,
         sliders: sliders.len(),
+        repaired,
         seconds: clock.elapsed().as_secs_f64(),
         before,
         after,

@@ -562,6 +562,8 @@ pub struct Optimisation {
     pub sweeps: usize,
     /// Quad vertices that slid along the boundary curves after the local or vertex mode.
     pub sliders: usize,
+    /// Quad vertices moved last to raise the worst scaled Jacobians (local or vertex mode).
+    pub repaired: usize,
 }
 
 /// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
@@ -1485,6 +1487,7 @@ impl Pipeline {
                 energy_after: optimisation.energy_after,
                 sweeps: optimisation.sweeps,
                 sliders: optimisation.sliders,
+                repaired: optimisation.repaired,
             },
             before: optimisation.before,
             histograms: QualityHistograms {
