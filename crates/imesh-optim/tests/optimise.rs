@@ -292,21 +292,24 @@ fn the_control_points_follow_the_quad_vertices() {
     }
 }
 
+/// Stardist's quad mesh, optimised by the local mode with every promise checked (`check`), and
+/// again with `off` (the defaults with one step turned off): the start and both results.
+fn with_and_without(off: OptimOptions) -> (Remesh, (Remesh, OptimReport), (Remesh, OptimReport)) {
+    let start = quad_mesh(&support::fixture("stardist-mask2d_labels.png"));
+    let with = check(&start, Method::Local, Metric::ShapeAndSize);
+    let mut r = start.clone();
+    let report = optimise(&mut r, &off).unwrap();
+    (start, with, (r, report))
+}
+
 /// Sliding the boundary vertices along their curves (checked by `check`: they stay on them)
 /// lowers the energy below what the control points alone reach, and moves some of them.
 #[test]
 fn boundary_vertices_slide_along_their_curves() {
-    let start = quad_mesh(&support::fixture("stardist-mask2d_labels.png"));
-    let (slid, with) = check(&start, Method::Local, Metric::ShapeAndSize);
-    let mut fixed = start.clone();
-    let without = optimise(
-        &mut fixed,
-        &OptimOptions {
-            slide: false,
-            ..OptimOptions::default()
-        },
-    )
-    .unwrap();
+    let (start, (slid, with), (fixed, without)) = with_and_without(OptimOptions {
+        slide: false,
+        ..OptimOptions::default()
+    });
     assert!(with.sliders > 100, "{with:?}");
     assert_eq!(without.sliders, 0);
     assert!(
@@ -413,17 +416,10 @@ fn settled_points_are_not_solved() {
 /// kept).
 #[test]
 fn repair_raises_the_worst_corners() {
-    let start = quad_mesh(&support::fixture("stardist-mask2d_labels.png"));
-    let (_, with) = check(&start, Method::Local, Metric::ShapeAndSize);
-    let mut plain = start.clone();
-    let without = optimise(
-        &mut plain,
-        &OptimOptions {
-            repair: false,
-            ..OptimOptions::default()
-        },
-    )
-    .unwrap();
+    let (_, (_, with), (_, without)) = with_and_without(OptimOptions {
+        repair: false,
+        ..OptimOptions::default()
+    });
     eprintln!(
         "worst scaled Jacobian {:.3} → {:.3}, worst shape {:.3} → {:.3} ({} vertices moved); mean shape-and-size {:.4} → {:.4}",
         without.after.scaled_jacobian.min,

@@ -145,10 +145,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
 /// saying how many pixels changed.
 #[test]
 fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
-    let path = support::fixtures()
-        .into_iter()
-        .find(|p| p.ends_with("matplotlib-s1045_mri.png"))
-        .expect("the MRI fixture");
+    let path = support::fixture("matplotlib-s1045_mri.png");
     let run = |options: MeshOptions| Pipeline::new(options).run_path(&path).unwrap().report;
     let graded = run(MeshOptions {
         size: ElementSize::Graded,
@@ -206,10 +203,7 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
 
 #[test]
 fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
-    let path = support::fixtures()
-        .into_iter()
-        .find(|p| p.ends_with("skimage-coins.png"))
-        .expect("the coins fixture");
+    let path = support::fixture("skimage-coins.png");
     let run = |options: MeshOptions| Pipeline::new(options).run_path(&path).unwrap().report;
     let auto = run(MeshOptions::default());
     // The size from the quad count alone (coins' regions are wide): the clean-ups' size, and
@@ -242,10 +236,7 @@ fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
 
 #[test]
 fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
-    let path = support::fixtures()
-        .into_iter()
-        .find(|p| p.ends_with("skimage-camera.png"))
-        .expect("the camera fixture");
+    let path = support::fixture("skimage-camera.png");
     // The camera at 1300 × 1100: quads of the automatic size are about 12 pixels wide.
     let image = image::open(&path)
         .expect("the camera fixture loads")
@@ -337,10 +328,7 @@ fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
 /// bound.)
 #[test]
 fn options_given_in_pixels_stay_in_pixels_on_a_reduced_grid() {
-    let path = support::fixtures()
-        .into_iter()
-        .find(|p| p.ends_with("stardist-mask2d_labels.png"))
-        .expect("the stardist fixture");
+    let path = support::fixture("stardist-mask2d_labels.png");
     let run = |tolerance: Option<f64>| {
         let options = MeshOptions {
             size: ElementSize::Graded,

@@ -193,6 +193,15 @@ pub fn hostile_images() -> Vec<(&'static str, DynamicImage)> {
     ]
 }
 
+/// The fixture image `name` (a file of `fixtures/images`).
+pub fn fixture(name: &str) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/images")
+        .join(name);
+    assert!(path.is_file(), "no fixture {}", path.display());
+    path
+}
+
 /// The fixture images, sorted.
 pub fn fixtures() -> Vec<PathBuf> {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images");
