@@ -7,9 +7,10 @@
 //! nothing moves for quads already good enough), every quad held to the descent's floors: the
 //! worst quality, worst shape and worst scaled Jacobian never fall.
 
-use imesh_geom::Point;
+use imesh_geom::{Point, Triangulation};
+use imesh_quad::{ElementMesh, QuadMesh};
 
-use crate::variables::Variables;
+use crate::variables::{vertex_quads, Variables};
 use crate::Setup;
 
 /// Quads with a scaled Jacobian or a shape under this are repaired
@@ -39,40 +40,65 @@ const DIRECTIONS: [(f64, f64); 8] = [
 const FIRST_STEP: f64 = 0.25;
 const HALVINGS: usize = 12;
 
-/// Raises the worst scaled Jacobians and shapes of the vertex-mode variables' quads (`vars`
-/// from [`Variables::vertices`]) towards `bar`, moving `vertices`; returns how many vertices
-/// moved.
-/// Sequential and in a fixed order: the same on any number of threads.
-pub(crate) fn repair(vars: &Variables, vertices: &mut [Point], setup: &Setup, bar: f64) -> usize {
-    // The scaled Jacobian and the shape of quad `q`.
-    let corners = |vertices: &[Point], q: u32| {
-        let p = setup.quads[q as usize].map(|v| [vertices[v as usize].x, vertices[v as usize].y]);
-        (
-            imesh_quality::quad::scaled_jacobian(&p),
-            imesh_quality::quad::shape(&p),
-        )
+/// Raises the worst scaled Jacobians and shapes of `mesh`'s quads towards `bar`, moving its
+/// free vertices (those of the vertex mode: not on a constrained M edge of `elements`); returns
+/// how many moved. Sequential and in a fixed order: the same on any number of threads.
+pub(crate) fn repair(
+    t: &Triangulation,
+    elements: &ElementMesh,
+    mesh: &mut QuadMesh,
+    setup: &Setup,
+    bar: f64,
+) -> usize {
+    // The quads under the bar: by shape, which is at most the scaled Jacobian at every corner.
+    let poor = |vertices: &[Point]| -> Vec<u32> {
+        (0..setup.quads.len() as u32)
+            .filter(|&q| {
+                let p = setup.quads[q as usize]
+                    .map(|v| [vertices[v as usize].x, vertices[v as usize].y]);
+                imesh_quality::quad::shape(&p) < bar
+            })
+            .collect()
     };
+    let first = poor(&mesh.vertices);
+    if first.is_empty() {
+        return 0;
+    }
+    // Only the vertices within two rings of a poor quad can take part.
+    let around = vertex_quads(mesh);
+    let mut near = vec![false; mesh.vertices.len()];
+    for &q in &first {
+        for v in setup.quads[q as usize] {
+            for &r in around.row(v as usize) {
+                for u in setup.quads[r as usize] {
+                    near[u as usize] = true;
+                }
+            }
+        }
+    }
+    let vars = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
+    let vertices = &mut mesh.vertices;
     let mut moved = vec![false; vars.len()];
-    for _ in 0..PASSES {
+    let mut poor_quads = first;
+    for pass in 0..PASSES {
+        if pass > 0 {
+            poor_quads = poor(vertices);
+        }
         // The variables within two rings of a poor quad: those of the quads sharing a free
         // vertex with it (its own vertices' other quads).
-        let mut near = vec![false; vars.len()];
-        for q in 0..setup.quads.len() as u32 {
-            let (jacobian, shape) = corners(vertices, q);
-            if jacobian >= bar && shape >= bar {
-                continue;
-            }
+        let mut wanted = vec![false; vars.len()];
+        for &q in &poor_quads {
             for &i in vars.by_quad.row(q as usize) {
                 for &r in vars.quads.row(i as usize) {
                     for &j in vars.by_quad.row(r as usize) {
-                        near[j as usize] = true;
+                        wanted[j as usize] = true;
                     }
                 }
             }
         }
         let mut any = false;
-        for i in (0..vars.len()).filter(|&i| near[i]) {
-            if improve(vars, i, vertices, setup, bar, &corners) {
+        for i in (0..vars.len()).filter(|&i| wanted[i]) {
+            if improve(&vars, i, vertices, setup, bar) {
                 moved[i] = true;
                 any = true;
             }
@@ -87,14 +113,7 @@ pub(crate) fn repair(vars: &Variables, vertices: &mut [Point], setup: &Setup, ba
 /// Compass search for vertex variable `i`: the smallest of its quads' scaled Jacobians as high
 /// as the floors allow, then, at an equal smallest scaled Jacobian, the smallest of their shapes
 /// (both capped at `bar`). True when it moved.
-fn improve(
-    vars: &Variables,
-    i: usize,
-    vertices: &mut [Point],
-    setup: &Setup,
-    bar: f64,
-    corners: &impl Fn(&[Point], u32) -> (f64, f64),
-) -> bool {
+fn improve(vars: &Variables, i: usize, vertices: &mut [Point], setup: &Setup, bar: f64) -> bool {
     let v = vars.ids[i] as usize;
     let quads = vars.quads.row(i);
     // The objective at the current position, or None where a quad is invalid or under a floor.
@@ -102,10 +121,14 @@ fn improve(
         let (mut jacobian, mut shape) = (bar, bar);
         for &q in quads {
             let p = setup.quads[q as usize].map(|u| vertices[u as usize]);
-            setup.term(q as usize, &p)?;
-            let (j, s) = corners(vertices, q);
-            jacobian = jacobian.min(j);
+            let (_, s) = setup.feasible_quality(q as usize, &p)?;
             shape = shape.min(s);
+            // The scaled Jacobian is at least the shape: only a shape under the bar can leave
+            // it there.
+            if s < bar {
+                let j = imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y]));
+                jacobian = jacobian.min(j);
+            }
         }
         Some((jacobian, shape))
     };

@@ -49,7 +49,14 @@ impl Domain {
     }
 
     /// True when the segment `a b` lies on one side of the rectangle.
-    fn on_border(&self, a: Point2, b: Point2) -> bool {
+    ///
+    /// ```
+    /// use imesh_quality::Domain;
+    /// let d = Domain::image(4.0, 3.0);
+    /// assert!(d.on_border([4.0, 0.5], [4.0, 2.0]));
+    /// assert!(!d.on_border([0.0, 0.0], [4.0, 3.0])); // a diagonal, corner to corner
+    /// ```
+    pub fn on_border(&self, a: Point2, b: Point2) -> bool {
         (a[0] == b[0] && (a[0] == self.min[0] || a[0] == self.max[0]))
             || (a[1] == b[1] && (a[1] == self.min[1] || a[1] == self.max[1]))
     }

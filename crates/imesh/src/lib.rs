@@ -1706,16 +1706,13 @@ pub fn auto_majority(quad_size: f64) -> u32 {
 /// ```
 pub fn band_limited_size(g: &CurveGraph, width: f64, height: f64, quad_size: f64) -> f64 {
     let points = g.points();
-    let on_border = |a: imesh_geom::Point, b: imesh_geom::Point| {
-        (a.x == b.x && (a.x == 0.0 || a.x == width))
-            || (a.y == b.y && (a.y == 0.0 || a.y == height))
-    };
+    let domain = Domain::image(width, height);
     let length: f64 = g
         .edges()
         .iter()
         .map(|e| {
             let [a, b] = e.ends.map(|v| points[v as usize]);
-            if on_border(a, b) {
+            if domain.on_border([a.x, a.y], [b.x, b.y]) {
                 0.0
             } else {
                 a.distance_squared(b).sqrt()
