@@ -91,11 +91,25 @@ impl CostFunction for LocalEnergy<'_> {
 /// 0.8181 and 4 took 5.3 s for 0.8182 (more sweeps).
 const LINE_EVALUATIONS: usize = 5;
 
-/// Scratch buffers of one worker.
-#[derive(Default)]
+/// Scratch buffers of one worker, its Powell solver's included.
 struct Scratch {
     corners: Vec<(usize, [(Point, f64); 4])>,
     ring: Vec<[Point; 2]>,
+    powell: Powell,
+    x: Vec<f64>,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Self {
+            corners: Vec::new(),
+            ring: Vec::new(),
+            powell: Powell::new(1.0)
+                .with_tolerance(1e-4)
+                .with_line_search(1e-2, LINE_EVALUATIONS),
+            x: Vec::new(),
+        }
+    }
 }
 
 /// Where moving variable `i` lowers the energy of its quads: its best move, if any.
@@ -146,15 +160,20 @@ fn solve(
     }
     let size = (area / scratch.corners.len() as f64).abs().sqrt();
     let (best, cost) = match setup.local_solver {
-        LocalSolver::Powell => Powell::new(0.2 * size)
-            .with_tolerance(1e-4)
-            .with_line_search(1e-2, LINE_EVALUATIONS)
-            .minimise_from(
+        LocalSolver::Powell => {
+            let powell = std::mem::replace(&mut scratch.powell, Powell::new(1.0));
+            scratch.powell = powell.with_initial_step(0.2 * size);
+            let x = &mut scratch.x;
+            x.clear();
+            x.extend([0.0, 0.0]);
+            let cost = scratch.powell.minimise_in_place(
                 |x| local.energy(Point::new(x[0], x[1])),
-                vec![0.0, 0.0],
+                x,
                 start,
                 setup.local_iterations,
-            ),
+            );
+            (Point::new(x[0], x[1]), cost)
+        }
         LocalSolver::Lbfgs => {
             let line = BacktrackingLineSearch::new(ArmijoCondition::new(1e-4).ok()?);
             let lbfgs = LBFGS::new(line, 3);
@@ -166,10 +185,11 @@ fn solve(
                 .run()
                 .ok()?;
             let state = result.state();
-            (state.get_best_param()?.clone(), state.get_best_cost())
+            let best = state.get_best_param()?;
+            (Point::new(best[0], best[1]), state.get_best_cost())
         }
     };
-    (cost < start).then(|| Point::new(best[0], best[1]))
+    (cost < start).then_some(best)
 }
 
 /// Runs sweeps of local solves over `variables`, moving `vertices` (and, in control mode,

@@ -22,22 +22,30 @@ enum Direction {
 }
 
 impl Direction {
-    /// `x + α d`.
-    fn step(&self, x: &[f64], alpha: f64) -> Vec<f64> {
-        let mut y = Vec::with_capacity(x.len());
-        self.step_into(x, alpha, &mut y);
-        y
-    }
-
     /// `x + α d`, written into `y` (a line search evaluates many steps: one buffer serves all).
     fn step_into(&self, x: &[f64], alpha: f64, y: &mut Vec<f64>) {
         y.clear();
         y.extend_from_slice(x);
+        self.step_in_place(y, alpha);
+    }
+
+    /// `x ← x + α d`.
+    fn step_in_place(&self, x: &mut [f64], alpha: f64) {
         match self {
-            Direction::Axis(i) => y[*i] += alpha,
-            Direction::Dense(d) => y.iter_mut().zip(d).for_each(|(y, d)| *y += alpha * d),
+            Direction::Axis(i) => x[*i] += alpha,
+            Direction::Dense(d) => x.iter_mut().zip(d).for_each(|(x, d)| *x += alpha * d),
         }
     }
+}
+
+/// Work vectors of one iteration, kept between iterations and between minimisations (the
+/// local optimiser runs hundreds of thousands of two-variable ones).
+#[derive(Clone, Debug, Default)]
+struct Buffers {
+    /// The iteration's start.
+    start: Vec<f64>,
+    /// The point a line search evaluates, and the extrapolated point.
+    trial: Vec<f64>,
 }
 
 /// Powell's method.
@@ -68,6 +76,7 @@ impl Direction {
 #[derive(Clone, Debug)]
 pub struct Powell {
     directions: Vec<Direction>,
+    buffers: Buffers,
     initial_step: f64,
     tolerance: f64,
     line_tolerance: f64,
@@ -85,15 +94,13 @@ impl Powell {
     pub fn new(initial_step: f64) -> Self {
         Self {
             directions: Vec::new(),
-            initial_step: if initial_step > 0.0 && initial_step.is_finite() {
-                initial_step
-            } else {
-                1.0
-            },
+            buffers: Buffers::default(),
+            initial_step: 1.0,
             tolerance: 1e-8,
             line_tolerance: 1e-6,
             line_evaluations: 40,
         }
+        .with_initial_step(initial_step)
     }
 
     /// Stops when an iteration lowers the cost by less than this fraction of it.
@@ -120,13 +127,13 @@ impl Powell {
         x: &[f64],
         d: &Direction,
         fx: f64,
+        y: &mut Vec<f64>,
     ) -> Result<(f64, f64), E> {
         let mut budget = self.line_evaluations;
-        let mut y = Vec::with_capacity(x.len());
         let mut f = |alpha: f64, budget: &mut usize| -> Result<f64, E> {
             *budget = budget.saturating_sub(1);
-            d.step_into(x, alpha, &mut y);
-            let c = cost(&y)?;
+            d.step_into(x, alpha, y);
+            let c = cost(y)?;
             Ok(if c.is_nan() { f64::INFINITY } else { c })
         };
         // Bracket: find a downhill step (shrinking it past infeasible or uphill points), then
@@ -232,20 +239,38 @@ impl Powell {
         Ok((xb, fxb))
     }
 
-    /// One iteration from `x0` (cost `f0`): a line search along each direction, then possibly
-    /// one along the net displacement, which may replace the direction of largest decrease.
+    /// One iteration from `x` (cost `f0`), moving `x`: a line search along each direction,
+    /// then possibly one along the net displacement, which may replace the direction of largest
+    /// decrease. Returns the cost reached.
     fn iterate<E>(
         &mut self,
         cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, E>,
-        x0: Vec<f64>,
+        x: &mut [f64],
         f0: f64,
-    ) -> Result<(Vec<f64>, f64), E> {
-        let (mut x, mut fx) = (x0.clone(), f0);
+    ) -> Result<f64, E> {
+        let mut buffers = std::mem::take(&mut self.buffers);
+        let result = self.iterate_with(cost, x, f0, &mut buffers);
+        self.buffers = buffers;
+        result
+    }
+
+    /// [`Powell::iterate`] with the work vectors taken out of `self`.
+    fn iterate_with<E>(
+        &mut self,
+        cost: &mut impl FnMut(&Vec<f64>) -> Result<f64, E>,
+        x: &mut [f64],
+        f0: f64,
+        buffers: &mut Buffers,
+    ) -> Result<f64, E> {
+        let Buffers { start, trial } = buffers;
+        start.clear();
+        start.extend_from_slice(x);
+        let mut fx = f0;
         let (mut biggest, mut biggest_at) = (0.0, 0);
         for (i, d) in self.directions.iter().enumerate() {
-            let (alpha, f) = self.line_minimum(cost, &x, d, fx)?;
+            let (alpha, f) = self.line_minimum(cost, x, d, fx, trial)?;
             if f < fx {
-                x = d.step(&x, alpha);
+                d.step_in_place(x, alpha);
                 if fx - f > biggest {
                     (biggest, biggest_at) = (fx - f, i);
                 }
@@ -255,17 +280,18 @@ impl Powell {
         // Extrapolate along the net displacement; adopt it as a direction only when Powell's test
         // says the set stays conjugate (the largest single decrease did not dominate).
         if fx < f0 {
-            let displacement: Vec<f64> = x.iter().zip(&x0).map(|(a, b)| a - b).collect();
-            let extrapolated: Vec<f64> = x.iter().zip(&displacement).map(|(a, d)| a + d).collect();
-            let fe = cost(&extrapolated)?;
+            trial.clear();
+            trial.extend(x.iter().zip(start.iter()).map(|(a, b)| a + (a - b)));
+            let fe = cost(trial)?;
             if fe < f0 {
                 let t = 2.0 * (f0 - 2.0 * fx + fe) * (f0 - fx - biggest).powi(2)
                     - biggest * (f0 - fe).powi(2);
                 if t < 0.0 {
-                    let d = Direction::Dense(displacement);
-                    let (alpha, f) = self.line_minimum(cost, &x, &d, fx)?;
+                    let displacement = x.iter().zip(start.iter()).map(|(a, b)| a - b);
+                    let d = Direction::Dense(displacement.collect());
+                    let (alpha, f) = self.line_minimum(cost, x, &d, fx, trial)?;
                     if f < fx {
-                        x = d.step(&x, alpha);
+                        d.step_in_place(x, alpha);
                         fx = f;
                     }
                     self.directions.remove(biggest_at);
@@ -273,7 +299,7 @@ impl Powell {
                 }
             }
         }
-        Ok((x, fx))
+        Ok(fx)
     }
 
     /// Whether an iteration from cost `f0` to `f` lowered it by less than the tolerance (or left
@@ -315,23 +341,62 @@ impl Powell {
     /// ```
     pub fn minimise_from(
         mut self,
-        mut cost: impl FnMut(&Vec<f64>) -> f64,
+        cost: impl FnMut(&Vec<f64>) -> f64,
         x0: Vec<f64>,
         f0: f64,
         max_iters: u64,
     ) -> (Vec<f64>, f64) {
+        let mut x = x0;
+        let fx = self.minimise_in_place(cost, &mut x, f0, max_iters);
+        (x, fx)
+    }
+
+    /// [`Powell::minimise_from`] moving `x` in place and returning its cost, with the solver's
+    /// work vectors kept for the next call: for many small problems solved one after another,
+    /// as the local optimiser's (the initial step is set for each by
+    /// [`Powell::with_initial_step`]).
+    ///
+    /// ```
+    /// use imesh_optim::Powell;
+    /// let mut powell = Powell::new(0.1);
+    /// for target in [1.0, -2.0] {
+    ///     let quadratic = |x: &Vec<f64>| (x[0] - target).powi(2) + 2.0 * (x[1] + 0.5).powi(2);
+    ///     let mut x = vec![0.0, 0.0];
+    ///     let f = powell.minimise_in_place(quadratic, &mut x, quadratic(&vec![0.0, 0.0]), 50);
+    ///     assert!((x[0] - target).abs() < 1e-6 && (x[1] + 0.5).abs() < 1e-6 && f < 1e-10);
+    /// }
+    /// ```
+    pub fn minimise_in_place(
+        &mut self,
+        mut cost: impl FnMut(&Vec<f64>) -> f64,
+        x: &mut [f64],
+        f0: f64,
+        max_iters: u64,
+    ) -> f64 {
         let mut cost = |y: &Vec<f64>| -> Result<f64, Infallible> { Ok(cost(y)) };
-        let (mut x, mut fx) = (x0, f0);
-        self.directions = (0..x.len()).map(Direction::Axis).collect();
+        let mut fx = f0;
+        self.directions.clear();
+        self.directions.extend((0..x.len()).map(Direction::Axis));
         let mut previous = f64::INFINITY;
         for iter in 0..max_iters {
             if iter > 0 && self.converged(previous, fx) {
                 break;
             }
-            let Ok((next, f)) = self.iterate(&mut cost, x.clone(), fx);
-            (x, previous, fx) = (next, fx, f);
+            let Ok(f) = self.iterate(&mut cost, x, fx);
+            (previous, fx) = (fx, f);
         }
-        (x, fx)
+        fx
+    }
+
+    /// The same solver with first line-search steps of `initial_step` (its work vectors kept).
+    #[must_use]
+    pub fn with_initial_step(mut self, initial_step: f64) -> Self {
+        self.initial_step = if initial_step > 0.0 && initial_step.is_finite() {
+            initial_step
+        } else {
+            1.0
+        };
+        self
     }
 }
 
@@ -362,11 +427,11 @@ where
         problem: &mut Problem<O>,
         mut state: IterState<Vec<f64>, (), (), (), (), f64>,
     ) -> Result<(IterState<Vec<f64>, (), (), (), (), f64>, Option<KV>), Error> {
-        let x0 = state
+        let mut x = state
             .take_param()
             .ok_or_else(|| Error::msg("Powell lost its parameter vector"))?;
         let f0 = state.get_cost();
-        let (x, fx) = self.iterate(&mut |x| problem.cost(x), x0, f0)?;
+        let fx = self.iterate(&mut |x| problem.cost(x), &mut x, f0)?;
         Ok((state.param(x).cost(fx), None))
     }
 
