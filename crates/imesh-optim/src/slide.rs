@@ -12,7 +12,7 @@ use imesh_geom::Point;
 use imesh_quad::Remesh;
 use rayon::prelude::*;
 
-use crate::variables::{by_quad, colour, vertex_quads};
+use crate::variables::{by_quad, colour, vertex_quads, Rows};
 use crate::Setup;
 
 /// One G' edge's boundary path: the pieces (M edges) in order along it, and the quad vertices
@@ -40,7 +40,7 @@ pub(crate) struct Sliders {
     /// Per chain, the position of each vertex along it.
     along: Vec<Vec<f64>>,
     /// Per slider, the quads around its vertex.
-    quads: Vec<Vec<u32>>,
+    quads: Rows<u32>,
     /// Sliders by colour: two of one colour share no quad (so neither bounds the other).
     colours: Vec<Vec<u32>>,
 }
@@ -114,11 +114,11 @@ impl Sliders {
             .collect();
         let around = vertex_quads(mesh);
         let mut slot = Vec::new();
-        let mut quads = Vec::new();
+        let mut quads = Rows::new();
         for (c, chain) in chains.iter().enumerate() {
             for j in 1..chain.vertices.len() - 1 {
                 slot.push((c as u32, j as u32));
-                quads.push(around.row(chain.vertices[j] as usize).to_vec());
+                quads.push_row(around.row(chain.vertices[j] as usize).iter().copied());
             }
         }
         let colours = colour(&quads, &by_quad(&quads, mesh.quads.len()));
@@ -205,7 +205,7 @@ impl Sliders {
         let energy = |a: f64| -> f64 {
             let p = chain.point(a);
             let mut sum = 0.0;
-            for &q in &self.quads[i] {
+            for &q in self.quads.row(i) {
                 let corners =
                     setup.quads[q as usize].map(|u| if u == v { p } else { vertices[u as usize] });
                 match setup.term(q as usize, &corners) {
@@ -217,7 +217,7 @@ impl Sliders {
         };
         let start = along[j as usize];
         let before = energy(start);
-        if !before.is_finite() || before <= setup.settled_term * self.quads[i].len() as f64 {
+        if !before.is_finite() || before <= setup.settled_term * self.quads.row(i).len() as f64 {
             return None;
         }
         // Golden section on [lo, hi]; the start is kept as the best until beaten.

@@ -14,19 +14,80 @@ pub(crate) struct Rows<T> {
 }
 
 impl<T> Rows<T> {
-    fn from_lists(lists: Vec<Vec<T>>) -> Self {
-        let mut first = Vec::with_capacity(lists.len() + 1);
-        first.push(0);
-        let mut items = Vec::new();
-        for list in lists {
-            items.extend(list);
-            first.push(items.len() as u32);
+    /// No rows yet: [`Rows::push_row`] adds them.
+    pub(crate) fn new() -> Self {
+        Self {
+            first: vec![0],
+            items: Vec::new(),
         }
-        Self { first, items }
+    }
+
+    /// Appends a row.
+    pub(crate) fn push_row(&mut self, row: impl IntoIterator<Item = T>) {
+        self.items.extend(row);
+        self.first.push(self.items.len() as u32);
     }
 
     pub(crate) fn row(&self, i: usize) -> &[T] {
         &self.items[self.first[i] as usize..self.first[i + 1] as usize]
+    }
+
+    /// Number of rows.
+    pub(crate) fn len(&self) -> usize {
+        self.first.len().saturating_sub(1)
+    }
+}
+
+impl<T: Copy> Rows<T> {
+    /// `rows` rows from `(row, item)` pairs, each row's items in the pairs' order (a counting
+    /// sort: no list per row).
+    pub(crate) fn from_pairs(rows: usize, pairs: &[(u32, T)]) -> Self {
+        let mut first = vec![0u32; rows + 1];
+        for &(r, _) in pairs {
+            first[r as usize + 1] += 1;
+        }
+        for r in 0..rows {
+            first[r + 1] += first[r];
+        }
+        let mut next: Vec<u32> = first[..rows].to_vec();
+        let mut items = Vec::with_capacity(pairs.len());
+        // Every slot is written once below; the first pair's item stands in until then.
+        if let Some(&(_, x)) = pairs.first() {
+            items.resize(pairs.len(), x);
+        }
+        for &(r, x) in pairs {
+            items[next[r as usize] as usize] = x;
+            next[r as usize] += 1;
+        }
+        Self { first, items }
+    }
+
+    /// Keeps, in every row, the items `keep` says yes to (given the row and the item).
+    fn retain(&mut self, mut keep: impl FnMut(usize, &[T], usize) -> bool) {
+        let mut items = Vec::with_capacity(self.items.len());
+        let mut first = Vec::with_capacity(self.first.len());
+        first.push(0);
+        for r in 0..self.len() {
+            let row = self.row(r);
+            for k in 0..row.len() {
+                if keep(r, row, k) {
+                    items.push(row[k]);
+                }
+            }
+            first.push(items.len() as u32);
+        }
+        *self = Self { first, items };
+    }
+
+    /// Keeps the rows `keep` says yes to.
+    fn keep_rows(&self, keep: &[bool]) -> Self {
+        let mut rows = Self::new();
+        for (r, &k) in keep.iter().enumerate() {
+            if k {
+                rows.push_row(self.row(r).iter().copied());
+            }
+        }
+        rows
     }
 }
 
@@ -89,13 +150,10 @@ fn constrained_edges(t: &Triangulation, m: &ElementMesh) -> Vec<bool> {
 
 /// Per quad vertex, the quads around it.
 pub(crate) fn vertex_quads(mesh: &QuadMesh) -> Rows<u32> {
-    let mut lists = vec![Vec::new(); mesh.vertices.len()];
-    for (q, quad) in mesh.quads.iter().enumerate() {
-        for &v in quad {
-            lists[v as usize].push(q as u32);
-        }
-    }
-    Rows::from_lists(lists)
+    let pairs: Vec<(u32, u32)> = (mesh.quads.iter().enumerate())
+        .flat_map(|(q, quad)| quad.map(|v| (v, q as u32)))
+        .collect();
+    Rows::from_pairs(mesh.vertices.len(), &pairs)
 }
 
 impl Variables {
@@ -122,11 +180,39 @@ impl Variables {
             Template::triangle(mesh.level()),
             Template::quad(mesh.level()),
         ];
+        // Per element kind and slot: the template points the slot's control point moves (with
+        // their weights), and the edges of the net cells around it, opposite to it.
         let cells = [triangle_cells(), quad_cells()];
+        let by_slot: [Vec<Vec<(usize, f64)>>; 2] = [0, 1].map(|kind| {
+            (0..16)
+                .map(|s| {
+                    (templates[kind].weights.iter().enumerate())
+                        .filter(|(_, w)| w[s] != 0.0)
+                        .map(|(point, w)| (point, w[s]))
+                        .collect()
+                })
+                .collect()
+        });
+        let ring_of: [Vec<Vec<[usize; 2]>>; 2] = [0, 1].map(|kind| {
+            (0..16)
+                .map(|s| {
+                    let mut edges = Vec::new();
+                    for cell in &cells[kind] {
+                        if let Some(at) = cell.iter().position(|&x| x == s) {
+                            let n = cell.len();
+                            for step in 1..n - 1 {
+                                edges.push([cell[(at + step) % n], cell[(at + step + 1) % n]]);
+                            }
+                        }
+                    }
+                    edges
+                })
+                .collect()
+        });
         let mut variable_of = vec![u32::MAX; net.points.len()];
         let mut ids = Vec::new();
-        let mut influence: Vec<Vec<(u32, f64)>> = Vec::new();
-        let mut ring: Vec<Vec<[u32; 2]>> = Vec::new();
+        let mut influence: Vec<(u32, (u32, f64))> = Vec::new();
+        let mut ring: Vec<(u32, [u32; 2])> = Vec::new();
         for (k, element) in m.elements.iter().enumerate() {
             let kind = usize::from(matches!(element, Element::Quad(_)));
             let slots = if kind == 1 { 16 } else { 10 };
@@ -140,53 +226,47 @@ impl Variables {
                 if variable_of[c as usize] == u32::MAX {
                     variable_of[c as usize] = ids.len() as u32;
                     ids.push(c);
-                    influence.push(Vec::new());
-                    ring.push(Vec::new());
                 }
-                let i = variable_of[c as usize] as usize;
-                for (&v, w) in vertices.iter().zip(&templates[kind].weights) {
-                    if w[s] != 0.0 {
-                        influence[i].push((v, w[s]));
-                    }
-                }
-                for cell in &cells[kind] {
-                    if let Some(at) = cell.iter().position(|&x| x == s) {
-                        let n = cell.len();
-                        for step in 1..n - 1 {
-                            let a = cell[(at + step) % n];
-                            let b = cell[(at + step + 1) % n];
-                            ring[i].push([patch[a], patch[b]]);
-                        }
-                    }
-                }
+                let i = variable_of[c as usize];
+                influence.extend(
+                    by_slot[kind][s]
+                        .iter()
+                        .map(|&(point, w)| (i, (vertices[point], w))),
+                );
+                ring.extend(
+                    ring_of[kind][s]
+                        .iter()
+                        .map(|&[a, b]| (i, [patch[a], patch[b]])),
+                );
             }
         }
-        for list in &mut influence {
-            // A vertex on a side shared by two patches appears in both, with the same weight.
-            list.sort_by_key(|&(v, _)| v);
-            list.dedup_by_key(|&mut (v, _)| v);
+        let mut influence = Rows::from_pairs(ids.len(), &influence);
+        let ring = Rows::from_pairs(ids.len(), &ring);
+        // A vertex on a side shared by two patches appears in both, with the same weight: the
+        // first is kept, and the rows sorted by vertex.
+        for r in 0..influence.len() {
+            let (a, b) = (influence.first[r] as usize, influence.first[r + 1] as usize);
+            influence.items[a..b].sort_by_key(|&(v, _)| v);
         }
+        influence.retain(|_, row, k| k == 0 || row[k].0 != row[k - 1].0);
         // Control points that move exactly the same quad vertices are one degree of freedom
         // solved several times: at level 1 a quad patch's four inner points all move only its
         // centre, and an edge's two inner points the same midpoint and centres. The first of
         // each such set is kept.
-        let mut seen = std::collections::HashMap::new();
-        let keep: Vec<bool> = influence
-            .iter()
-            .map(|list| {
-                let key: Vec<u32> = list.iter().map(|&(v, _)| v).collect();
-                seen.insert(key, ()).is_none()
+        let keys: Vec<u32> = influence.items.iter().map(|&(v, _)| v).collect();
+        let mut seen = std::collections::HashSet::new();
+        let keep: Vec<bool> = (0..influence.len())
+            .map(|r| {
+                seen.insert(&keys[influence.first[r] as usize..influence.first[r + 1] as usize])
             })
             .collect();
-        fn pick<T>(list: Vec<T>, keep: &[bool]) -> Vec<T> {
-            list.into_iter()
-                .zip(keep)
-                .filter(|&(_, &k)| k)
-                .map(|(x, _)| x)
-                .collect()
-        }
-        let (ids, influence, ring) = (pick(ids, &keep), pick(influence, &keep), pick(ring, &keep));
-        Self::finish(ids, influence, ring, mesh)
+        let ids = ids
+            .into_iter()
+            .zip(&keep)
+            .filter(|&(_, &k)| k)
+            .map(|(x, _)| x)
+            .collect();
+        Self::finish(ids, influence.keep_rows(&keep), ring.keep_rows(&keep), mesh)
     }
 
     /// The free quad vertices: all but those on constrained M edges (vertex mode).
@@ -212,37 +292,46 @@ impl Variables {
         let ids: Vec<u32> = (0..mesh.vertices.len() as u32)
             .filter(|&v| !fixed[v as usize] && wanted(v))
             .collect();
-        let influence = ids.iter().map(|&v| vec![(v, 1.0)]).collect();
-        let ring = vec![Vec::new(); ids.len()];
+        let mut influence = Rows::new();
+        let mut ring = Rows::new();
+        for &v in &ids {
+            influence.push_row([(v, 1.0)]);
+            ring.push_row([]);
+        }
         Self::finish(ids, influence, ring, mesh)
     }
 
     fn finish(
         ids: Vec<u32>,
-        influence: Vec<Vec<(u32, f64)>>,
-        ring: Vec<Vec<[u32; 2]>>,
+        influence: Rows<(u32, f64)>,
+        ring: Rows<[u32; 2]>,
         mesh: &QuadMesh,
     ) -> Self {
         let around = vertex_quads(mesh);
-        let quads: Vec<Vec<u32>> = influence
-            .iter()
-            .map(|list| {
-                let mut qs: Vec<u32> = list
-                    .iter()
-                    .flat_map(|&(v, _)| around.row(v as usize).iter().copied())
-                    .collect();
-                qs.sort_unstable();
-                qs.dedup();
-                qs
-            })
-            .collect();
+        // The quads around a variable's vertices, each once (a stamp per quad), sorted.
+        let mut stamp = vec![u32::MAX; mesh.quads.len()];
+        let mut quads = Rows::new();
+        let mut row = Vec::new();
+        for i in 0..influence.len() {
+            row.clear();
+            for &(v, _) in influence.row(i) {
+                for &q in around.row(v as usize) {
+                    if stamp[q as usize] != i as u32 {
+                        stamp[q as usize] = i as u32;
+                        row.push(q);
+                    }
+                }
+            }
+            row.sort_unstable();
+            quads.push_row(row.iter().copied());
+        }
         let by_quad = by_quad(&quads, mesh.quads.len());
         let colours = colour(&quads, &by_quad);
         Self {
             ids,
-            influence: Rows::from_lists(influence),
-            quads: Rows::from_lists(quads),
-            ring: Rows::from_lists(ring),
+            influence,
+            quads,
+            ring,
             colours,
             by_quad,
         }
@@ -274,24 +363,21 @@ impl Variables {
 }
 
 /// Per quad (of `n_quads`), the items whose quad lists (`quads`) hold it.
-pub(crate) fn by_quad(quads: &[Vec<u32>], n_quads: usize) -> Rows<u32> {
-    let mut lists = vec![Vec::new(); n_quads];
-    for (i, qs) in quads.iter().enumerate() {
-        for &q in qs {
-            lists[q as usize].push(i as u32);
-        }
-    }
-    Rows::from_lists(lists)
+pub(crate) fn by_quad(quads: &Rows<u32>, n_quads: usize) -> Rows<u32> {
+    let pairs: Vec<(u32, u32)> = (0..quads.len())
+        .flat_map(|i| quads.row(i).iter().map(move |&q| (q, i as u32)))
+        .collect();
+    Rows::from_pairs(n_quads, &pairs)
 }
 
 /// Greedy colouring of the variables: each takes the smallest colour no earlier variable sharing
 /// one of its quads has.
-pub(crate) fn colour(quads: &[Vec<u32>], by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
+pub(crate) fn colour(quads: &Rows<u32>, by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
     let mut colour_of = vec![u32::MAX; quads.len()];
     let mut seen: Vec<usize> = Vec::new();
     let mut colours: Vec<Vec<u32>> = Vec::new();
-    for (i, qs) in quads.iter().enumerate() {
-        for &q in qs {
+    for i in 0..quads.len() {
+        for &q in quads.row(i) {
             for &j in by_quad.row(q as usize) {
                 let c = colour_of[j as usize];
                 if c != u32::MAX {
@@ -312,4 +398,41 @@ pub(crate) fn colour(quads: &[Vec<u32>], by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
         colours[c].push(i as u32);
     }
     colours
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Rows;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Rows from pairs hold, row by row, exactly the pairs' items in the pairs' order, as
+        /// lists built by pushing would; retaining and keeping rows agree with filtering those.
+        #[test]
+        fn rows_from_pairs_match_lists(
+            pairs in proptest::collection::vec((0u32..7, any::<u16>()), 0..60),
+            keep in proptest::collection::vec(any::<bool>(), 7),
+        ) {
+            let mut lists = vec![Vec::new(); 7];
+            for &(r, x) in &pairs {
+                lists[r as usize].push(x);
+            }
+            let mut rows = Rows::from_pairs(7, &pairs);
+            prop_assert_eq!(rows.len(), 7);
+            for (r, list) in lists.iter().enumerate() {
+                prop_assert_eq!(rows.row(r), &list[..]);
+            }
+            let kept = rows.keep_rows(&keep);
+            let expected: Vec<&Vec<u16>> = lists.iter().zip(&keep).filter(|(_, &k)| k).map(|(l, _)| l).collect();
+            prop_assert_eq!(kept.len(), expected.len());
+            for (r, list) in expected.iter().enumerate() {
+                prop_assert_eq!(kept.row(r), &list[..]);
+            }
+            rows.retain(|_, row, k| row[k] % 2 == 0);
+            for (r, list) in lists.iter().enumerate() {
+                let even: Vec<u16> = list.iter().copied().filter(|x| x % 2 == 0).collect();
+                prop_assert_eq!(rows.row(r), &even[..]);
+            }
+        }
+    }
 }
