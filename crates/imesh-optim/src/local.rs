@@ -18,8 +18,37 @@ use crate::{LocalSolver, Powell, Setup};
 struct LocalEnergy<'a> {
     corners: &'a [(usize, [(Point, f64); 4])],
     ring: &'a [[Point; 2]],
+    /// A squared distance from `origin` within which every point is strictly left of every
+    /// ring edge: the origin is, and no edge's line comes closer (with a margin far above the
+    /// rounding of the distances). Most trial steps are that short, and skip the predicates.
+    clear2: f64,
     origin: Point,
     setup: Setup<'a>,
+}
+
+/// The share of the nearest ring edge's distance within which [`LocalEnergy`] trusts a step
+/// without the exact predicates.
+const RING_MARGIN: f64 = 0.99;
+
+/// A lower bound on the squared distance from `p` to the nearest line through a ring edge,
+/// times [`RING_MARGIN`]² (0 for no edge: then nothing is tested anyway). The differences are
+/// rounded to within a relative 2⁻⁵³ of their exact values, so the cross product is within
+/// `4ε (|dₓ rᵧ| + |d_y rₓ|)` of the exact one: `1e-12` times that sum is taken off it.
+fn ring_clearance(ring: &[[Point; 2]], p: Point) -> f64 {
+    let nearest = ring
+        .iter()
+        .map(|&[a, b]| {
+            let (d, r) = (b - a, p - a);
+            let (u, v) = (d.x * r.y, d.y * r.x);
+            let cross = ((u - v).abs() - 1e-12 * (u.abs() + v.abs())).max(0.0);
+            cross * cross / (d.x * d.x + d.y * d.y)
+        })
+        .fold(f64::INFINITY, f64::min);
+    if nearest.is_finite() {
+        nearest * RING_MARGIN * RING_MARGIN
+    } else {
+        0.0
+    }
 }
 
 /// `base + δ · w`, written once so that the solve and the update compute the same bits (a
@@ -32,10 +61,13 @@ pub(crate) fn moved(base: Point, delta: Point, w: f64) -> Point {
 impl LocalEnergy<'_> {
     fn energy(&self, delta: Point) -> f64 {
         let p = self.origin + delta;
-        if !self
-            .ring
-            .iter()
-            .all(|&[a, b]| imesh_geom::predicates::orient2d(a, b, p) > 0.0)
+        // The step as taken (`p` is rounded): within `clear2`, inside every ring edge.
+        let step = p - self.origin;
+        if step.x * step.x + step.y * step.y >= self.clear2
+            && !self
+                .ring
+                .iter()
+                .all(|&[a, b]| imesh_geom::predicates::orient2d(a, b, p) > 0.0)
         {
             return f64::INFINITY;
         }
@@ -150,6 +182,7 @@ fn solve(
     let local = LocalEnergy {
         corners: &scratch.corners,
         ring: &scratch.ring,
+        clear2: ring_clearance(&scratch.ring, origin),
         origin,
         setup,
     };
@@ -257,4 +290,47 @@ pub(crate) fn descend(
         }
     }
     sweeps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ring_clearance;
+    use imesh_geom::predicates::orient2d;
+    use imesh_geom::Point;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Every point within the clearance of a point strictly inside a ring is strictly
+        /// inside it too (exact predicates), however close to an edge, and however far from
+        /// the origin of coordinates.
+        #[test]
+        fn points_within_the_ring_clearance_are_inside(
+            n in 3usize..9, radius in 1e-6f64..10.0, offset in -1e6f64..1e6,
+            jitter in proptest::collection::vec(0.5f64..1.0, 9),
+            at in (-1.0f64..1.0, -1.0f64..1.0), direction in 0.0f64..std::f64::consts::TAU,
+        ) {
+            let centre = Point::new(offset, -offset / 3.0);
+            let corners: Vec<Point> = (0..n)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / n as f64;
+                    let r = radius * jitter[k];
+                    Point::new(centre.x + r * a.cos(), centre.y + r * a.sin())
+                })
+                .collect();
+            let ring: Vec<[Point; 2]> = (0..n).map(|k| [corners[k], corners[(k + 1) % n]]).collect();
+            let p = Point::new(centre.x + 0.5 * radius * at.0, centre.y + 0.5 * radius * at.1);
+            prop_assume!(ring.iter().all(|&[a, b]| orient2d(a, b, p) > 0.0));
+            let clear = ring_clearance(&ring, p).sqrt();
+            for scale in [0.999_999, 0.5, 1e-3, 1e-9] {
+                let q = Point::new(
+                    p.x + clear * scale * direction.cos(),
+                    p.y + clear * scale * direction.sin(),
+                );
+                let step = q - p;
+                if step.x * step.x + step.y * step.y < clear * clear {
+                    prop_assert!(ring.iter().all(|&[a, b]| orient2d(a, b, q) > 0.0));
+                }
+            }
+        }
+    }
 }
