@@ -52,10 +52,44 @@ pub const BOUNDARY_PIECE: f64 = 1.5;
 /// # Errors
 /// [`GeomError`] from an insertion (it cannot happen for a valid triangulation).
 pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, GeomError> {
+    uniform_points_with_lattice(t, spacing, spacing)
+}
+
+/// [`uniform_points`] with a lattice of its own spacing, `lattice`: the boundary pieces follow
+/// `spacing`, the lattice and its clearance `lattice`. A lattice a little coarser than the
+/// boundary pieces makes the inside's quads as large as the mesh's mean quad where the band
+/// along the boundaries holds many small ones.
+///
+/// ```
+/// use imesh_geom::{Point, Triangulation};
+/// use imesh_quad::uniform_points_with_lattice;
+/// let corners = [Point::new(0.0, 0.0), Point::new(12.0, 0.0), Point::new(12.0, 8.0), Point::new(0.0, 8.0)];
+/// let (mut t, v) = Triangulation::from_points(&corners).unwrap();
+/// for k in 0..4 {
+///     t.insert_segment(v[k], v[(k + 1) % 4]).unwrap();
+/// }
+/// t.set_labels(|_| 0);
+/// // A lattice of 4: 4 × 3 points, 8 of them new (not the corners); its border points cut
+/// // the sides into pieces of 4, each split once to stay within 1.5 × 2: 10 more.
+/// assert_eq!(uniform_points_with_lattice(&mut t, 2.0, 4.0).unwrap(), (4 * 3 - 4) + 10);
+/// t.check().unwrap();
+/// ```
+///
+/// # Errors
+/// As [`uniform_points`].
+pub fn uniform_points_with_lattice(
+    t: &mut Triangulation,
+    spacing: f64,
+    lattice: f64,
+) -> Result<usize, GeomError> {
     let before = t.num_vertices();
-    if !(spacing.is_finite() && spacing > 0.0) || t.is_degenerate() {
+    if !(spacing.is_finite() && spacing > 0.0 && lattice.is_finite() && lattice > 0.0)
+        || t.is_degenerate()
+    {
         return Ok(0);
     }
+    let piece = spacing;
+    let spacing = lattice;
     let lattice = Lattice::new(t, spacing);
     let reach = CLEARANCE * spacing;
 
@@ -90,7 +124,7 @@ pub fn uniform_points(t: &mut Triangulation, spacing: f64) -> Result<usize, Geom
     }
 
     // 2. The boundaries.
-    t.split_long_segments(BOUNDARY_PIECE * spacing)?;
+    t.split_long_segments(BOUNDARY_PIECE * piece)?;
 
     // 3. The inside.
     let grid = EdgeGrid::new(t, reach);

@@ -26,6 +26,9 @@ pub struct DensityOptions {
     /// larger than [`MAX_TRIANGLE_AREA`] squared spacings. `None` leaves DT' graded from the
     /// boundary pieces inwards.
     pub spacing: Option<f64>,
+    /// The inside lattice's spacing as a multiple of [`DensityOptions::spacing`] (1: the same;
+    /// [`crate::uniform_points_with_lattice`]).
+    pub lattice_scale: f64,
 }
 
 impl Default for DensityOptions {
@@ -35,6 +38,7 @@ impl Default for DensityOptions {
             max_steiner: usize::MAX,
             max_size: None,
             spacing: None,
+            lattice_scale: 1.0,
         }
     }
 }
@@ -122,7 +126,8 @@ impl RegionTriangulation {
         let labels = region_labels(&triangulation, &segment_edge, g);
         triangulation.set_labels(|t| labels[t.index()]);
         if let Some(h) = options.spacing {
-            let points = crate::density::lattice_points(&triangulation, h);
+            let lattice = h * options.lattice_scale;
+            let points = crate::density::lattice_points(&triangulation, lattice);
             if points > options.max_steiner as u64 {
                 return Err(QuadError::LatticeTooFine {
                     spacing: h,
@@ -130,7 +135,7 @@ impl RegionTriangulation {
                     limit: options.max_steiner as u64,
                 });
             }
-            crate::uniform_points(&mut triangulation, h)?;
+            crate::uniform_points_with_lattice(&mut triangulation, h, lattice)?;
         }
         let refine = RefineOptions {
             min_angle_deg: options.min_angle_deg,

@@ -47,7 +47,7 @@ mod patch;
 mod template;
 
 pub use adapt::{adapt, AdaptReport, EdgeCurve, POOR_SCALED_JACOBIAN};
-pub use density::{uniform_points, BOUNDARY_PIECE, CLEARANCE};
+pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh};
 pub use pairing::{Element, ElementMesh, Pairing, MIN_MATCHING_CORNER};

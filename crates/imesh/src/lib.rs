@@ -485,6 +485,9 @@ pub struct Counts {
     pub dt_triangles: usize,
     /// Spacing of the uniform DT' in pixels (quads; 0 when graded).
     pub dt_spacing: f64,
+    /// Its inside lattice's spacing as a multiple of it (1 unless [`LATTICE_MATCH`]'s second
+    /// try was kept).
+    pub lattice_scale: f64,
     /// DT' triangles left unpaired (quads).
     pub unpaired_triangles: usize,
     /// G' edges whose curve was flattened to keep every quad valid (quads).
@@ -1359,35 +1362,55 @@ impl Pipeline {
             (q, _) => q,
         };
         let spacing = quad_size.map(|q| 2.0 * f64::from(o.template_level) * q);
-        let mut r = remesh(
-            &simplified.graph,
-            &curves,
-            &QuadOptions {
-                density: DensityOptions {
-                    min_angle_deg: o
-                        .min_angle
-                        .unwrap_or(DensityOptions::default().min_angle_deg),
-                    max_steiner: self.refinement_cap(),
-                    max_size: o.max_size,
-                    spacing,
+        let remesh_with = |lattice_scale: f64| {
+            remesh(
+                &simplified.graph,
+                &curves,
+                &QuadOptions {
+                    density: DensityOptions {
+                        min_angle_deg: o
+                            .min_angle
+                            .unwrap_or(DensityOptions::default().min_angle_deg),
+                        max_steiner: self.refinement_cap(),
+                        max_size: o.max_size,
+                        spacing,
+                        lattice_scale,
+                    },
+                    pairing: match o.pairing {
+                        PairingMethod::Greedy => Pairing::Greedy,
+                        PairingMethod::Matching => Pairing::Matching,
+                    },
+                    level: o.template_level,
+                    max_quads: o.max_elements,
                 },
-                pairing: match o.pairing {
-                    PairingMethod::Greedy => Pairing::Greedy,
-                    PairingMethod::Matching => Pairing::Matching,
-                },
-                level: o.template_level,
-                max_quads: o.max_elements,
-            },
-        )
-        .map_err(|e| match e {
-            imesh_quad::QuadError::TooManyQuads { quads, .. } => {
-                self.too_many_elements(quads, "quads")
+            )
+            .map_err(|e| match e {
+                imesh_quad::QuadError::TooManyQuads { quads, .. } => {
+                    self.too_many_elements(quads, "quads")
+                }
+                imesh_quad::QuadError::LatticeTooFine { points, .. } => {
+                    self.too_many_elements(points, "vertices")
+                }
+                e => PipelineError::Quads(e),
+            })
+        };
+        let mut r = remesh_with(1.0)?;
+        counts.lattice_scale = 1.0;
+        if spacing.is_some() {
+            // The lattice's quads should have the mesh's mean area: where the band along the
+            // boundaries makes the mean differ from them (the median quad is a lattice quad), a
+            // lattice scaled by that ratio is tried, and the mesh with the higher mean
+            // shape-and-size (before optimisation) kept.
+            let (median, mean) = median_and_mean_area(&r.mesh);
+            let scale = (mean / median).clamp(1.0 / MAX_LATTICE_SCALE, MAX_LATTICE_SCALE);
+            if median > 0.0 && (scale - 1.0).abs() > LATTICE_MATCH {
+                let other = remesh_with(scale)?;
+                if mean_shape_and_size(&other.mesh) > mean_shape_and_size(&r.mesh) {
+                    r = other;
+                    counts.lattice_scale = scale;
+                }
             }
-            imesh_quad::QuadError::LatticeTooFine { points, .. } => {
-                self.too_many_elements(points, "vertices")
-            }
-            e => PipelineError::Quads(e),
-        })?;
+        }
         seconds.quads = start.elapsed().as_secs_f64() - fitting;
         seconds.dt = r.seconds.triangulation;
         seconds.pairing_templates = r.seconds.templates;
@@ -1674,6 +1697,50 @@ type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
 /// ```
 pub fn auto_majority(quad_size: f64) -> u32 {
     (quad_size.round().max(1.0) as u32).min(MAX_MAJORITY)
+}
+
+/// A uniform mesh whose median quad area (a lattice quad's) is off the mean by more than this
+/// share is meshed again with its lattice scaled by the ratio (the better of the two kept):
+/// measured on nine fixtures (all but aloe) with the lattice scaled by 0.985, 1, 1.015, 1.03 and
+/// 1.05, the mean shape-and-size before optimisation picked the best scale after it on seven,
+/// and the ratio hit it on pyvista (0.971: 0.859 → 0.872), brick (0.952: 0.796 → 0.806) and
+/// stardist (0.986: 0.857 → 0.863); MRI's lattice fits its mean to 0.1 % and scored 0.917 at 1,
+/// 0.907 at 0.985 and 0.915 at 1.015.
+pub const LATTICE_MATCH: f64 = 0.01;
+
+/// The most the lattice is scaled either way by [`LATTICE_MATCH`]'s second try.
+pub const MAX_LATTICE_SCALE: f64 = 1.1;
+
+/// The median and the mean quad area of `mesh` (0 for no quad).
+fn median_and_mean_area(mesh: &imesh_quad::QuadMesh) -> (f64, f64) {
+    let mut areas: Vec<f64> = (0..mesh.quads.len()).map(|q| quad_area(mesh, q)).collect();
+    if areas.is_empty() {
+        return (0.0, 0.0);
+    }
+    let mean = areas.iter().sum::<f64>() / areas.len() as f64;
+    let middle = areas.len() / 2;
+    let (_, median, _) = areas.select_nth_unstable_by(middle, f64::total_cmp);
+    (*median, mean)
+}
+
+/// Quad `q`'s area (shoelace).
+fn quad_area(mesh: &imesh_quad::QuadMesh, q: usize) -> f64 {
+    let p = mesh.quads[q].map(|v| mesh.vertices[v as usize]);
+    0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y))
+}
+
+/// The mean shape-and-size of `mesh`'s quads against their mean area.
+fn mean_shape_and_size(mesh: &imesh_quad::QuadMesh) -> f64 {
+    let (_, mean) = median_and_mean_area(mesh);
+    let sum: f64 = mesh
+        .quads
+        .iter()
+        .map(|quad| {
+            let p = quad.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
+            imesh_quality::quad::shape_and_size(&p, mean)
+        })
+        .sum();
+    sum / mesh.quads.len().max(1) as f64
 }
 
 /// The quad side for a uniform mesh of the `width` × `height` domain whose boundaries are `g`

@@ -234,6 +234,35 @@ fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
     assert!(mean(&auto) > mean(&coarse) + 0.02);
 }
 
+/// Where the band along the boundaries pulls the mean quad area off the lattice's (pyvista's
+/// channels: the median quad, a lattice one, is 0.971 of the mean), the lattice is scaled to
+/// match and kept for its higher shape-and-size (0.859 → 0.872); where the lattice fits (MRI,
+/// to 0.1 %), it stays.
+#[test]
+fn the_lattice_is_scaled_to_the_mean_quad() {
+    let run = |name: &str| {
+        Pipeline::new(MeshOptions::default())
+            .run_path(&support::fixture(name))
+            .unwrap()
+            .report
+    };
+    let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
+    let channels = run("pyvista-channels_z050_labels.png");
+    let mri = run("matplotlib-s1045_mri.png");
+    eprintln!(
+        "pyvista: lattice × {:.4}, mean S&S {:.4}; MRI: × {:.4}, {:.4}",
+        channels.counts.lattice_scale,
+        mean(&channels),
+        mri.counts.lattice_scale,
+        mean(&mri)
+    );
+    assert!(channels.validation.valid && mri.validation.valid);
+    assert!((1.02..=1.04).contains(&channels.counts.lattice_scale));
+    assert!(mean(&channels) >= 0.865, "{}", mean(&channels));
+    assert_eq!(mri.counts.lattice_scale, 1.0);
+    assert!(mean(&mri) >= 0.91);
+}
+
 #[test]
 fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     let path = support::fixture("skimage-camera.png");
