@@ -245,7 +245,7 @@ pub(crate) struct Setup<'a> {
     pub metric: Metric,
     pub average_area: f64,
     /// Quad `q` may not fall below quality `quality_floors[q]`: [`OptimOptions::keep_quality`]
-    /// if it started there, else the start's worst...
+    /// if it started there (or the start's worst if that is higher), else the start's worst...
     pub quality_floors: &'a [f64],
     /// ... and quad `q` not below shape `shape_floors[q]` (its own start shape, or
     /// [`OptimOptions::keep_shape`] if that is lower, but never below the start's worst),
@@ -445,8 +445,9 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     let quality_floors: Vec<f64> = start
         .iter()
         .map(|&s| {
+            // Never below the start's worst, however low the bar.
             if s >= options.keep_quality {
-                options.keep_quality
+                options.keep_quality.max(worst)
             } else {
                 worst
             }

@@ -501,4 +501,13 @@ fn good_quads_stay_good() {
     assert!(under(&with) < under(&without));
     assert!(under(&without) < under(&before));
     assert!(kept.energy_after < kept.energy_before);
+    // A bar under the start's worst quad still keeps that worst.
+    let (low, _) = run(1e-9);
+    assert!(low.before.shape_and_size.min > 1e-9);
+    assert!(
+        low.after.shape_and_size.min >= low.before.shape_and_size.min * (1.0 - 1e-12),
+        "{} → {}",
+        low.before.shape_and_size.min,
+        low.after.shape_and_size.min
+    );
 }
