@@ -1400,14 +1400,16 @@ impl Pipeline {
             // The lattice's quads should have the mesh's mean area: where the band along the
             // boundaries makes the mean differ from them (the median quad is a lattice quad), a
             // lattice scaled by that ratio is tried, and the mesh with the higher mean
-            // shape-and-size (before optimisation) kept.
+            // shape-and-size (before optimisation) kept. The second try is only a try: a finer
+            // lattice over a limit (`--max-steiner`, `--max-elements`) leaves the first.
             let (median, mean) = median_and_mean_area(&r.mesh);
             let scale = (mean / median).clamp(1.0 / MAX_LATTICE_SCALE, MAX_LATTICE_SCALE);
             if median > 0.0 && (scale - 1.0).abs() > LATTICE_MATCH {
-                let other = remesh_with(scale)?;
-                if mean_shape_and_size(&other.mesh) > mean_shape_and_size(&r.mesh) {
-                    r = other;
-                    counts.lattice_scale = scale;
+                if let Ok(other) = remesh_with(scale) {
+                    if mean_shape_and_size(&other.mesh) > mean_shape_and_size(&r.mesh) {
+                        r = other;
+                        counts.lattice_scale = scale;
+                    }
                 }
             }
         }
