@@ -263,6 +263,34 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     assert!(mean(&mri) >= 0.91);
 }
 
+/// The lattice's second try is only a try: on grass it is finer (0.982) and makes 67 587
+/// quads; under a limit of 67 000 the run keeps the first mesh (66 739) instead of failing.
+#[test]
+fn a_second_lattice_over_a_limit_keeps_the_first() {
+    let run = |max_elements: u64| {
+        Pipeline::new(MeshOptions {
+            max_elements,
+            ..Default::default()
+        })
+        .run_path(&support::fixture("skimage-grass.png"))
+        .unwrap()
+        .report
+    };
+    let free = run(MeshOptions::default().max_elements);
+    let limited = run(67_000);
+    eprintln!(
+        "grass: × {:.4}, {} quads; limited: × {:.4}, {} quads",
+        free.counts.lattice_scale,
+        free.counts.quads,
+        limited.counts.lattice_scale,
+        limited.counts.quads
+    );
+    assert!(free.counts.lattice_scale < 1.0 && free.counts.quads > 67_000);
+    assert_eq!(limited.counts.lattice_scale, 1.0);
+    assert!(limited.counts.quads <= 67_000);
+    assert!(limited.validation.valid);
+}
+
 #[test]
 fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     let path = support::fixture("skimage-camera.png");
