@@ -266,6 +266,13 @@ pub(crate) struct Setup<'a> {
     pub settled_term: f64,
 }
 
+/// A quad whose shape (as computed) is at least this, with a positive area, is valid without
+/// the exact test. Every corner's cross product `α = a × b` is then at least `shape · |a| |b|
+/// ≥ shape · (|aₓ b_y| + |a_y bₓ|)`, some 10⁵ times the bound on its rounding error (about
+/// `4ε` times that sum), so the exact orientation is positive too, and the area's sign says the
+/// corners turn left.
+const SURE_SHAPE: f64 = 1e-10;
+
 /// How far above a scaled-Jacobian floor a quad's shape must be for the floor to hold without
 /// computing the Jacobian: far above the rounding of either.
 const JACOBIAN_MARGIN: f64 = 1e-9;
@@ -305,10 +312,10 @@ impl Setup<'_> {
     /// The metric and the shape of quad `p` when it is valid and above both floors.
     #[inline]
     fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
-        if !is_valid(p) {
+        let (s, shape) = self.quality(p);
+        if !((shape >= SURE_SHAPE && energy::area(p) > 0.0) || is_valid(p)) {
             return None;
         }
-        let (s, shape) = self.quality(p);
         let jacobian = self.jacobian_floors[quad];
         // At every corner the scaled Jacobian α / (|a| |b|) is at least the shape's
         // 2α / (|a|² + |b|²): a shape clear of the floor spares computing the Jacobian.
@@ -613,6 +620,32 @@ mod tests {
     }
 
     proptest! {
+        /// The shortcut of [`SURE_SHAPE`] never calls a quad valid that the exact test calls
+        /// invalid: random quads, flat ones (a corner nudged by a hair off its neighbours'
+        /// line), far from the origin.
+        #[test]
+        fn a_sure_shape_is_a_valid_quad(
+            corners in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 4),
+            offset in -1e6f64..1e6, scale in 1e-6f64..1e3, flat in 0usize..4, hair in -1e-9f64..1e-9,
+        ) {
+            // A jittered unit square (mostly convex), or its mirror image half the time.
+            let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+            let mirror = if corners[0].0 < 0.0 { -1.0 } else { 1.0 };
+            let mut p: [Point; 4] = std::array::from_fn(|i| {
+                Point::new(
+                    offset + mirror * scale * (square[i].0 + 0.3 * corners[i].0),
+                    offset / 2.0 + scale * (square[i].1 + 0.3 * corners[i].1),
+                )
+            });
+            // Corner `flat` on the line of its neighbours, nudged across by `hair` of the scale.
+            let (a, b) = (p[(flat + 3) % 4], p[(flat + 1) % 4]);
+            p[flat] = Point::new(0.5 * (a.x + b.x) - hair * scale * (b.y - a.y), 0.5 * (a.y + b.y) + hair * scale * (b.x - a.x));
+            let shape = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
+            if shape >= SURE_SHAPE && energy::area(&p) > 0.0 {
+                prop_assert!(is_valid(&p), "{p:?}: shape {shape}");
+            }
+        }
+
         #[test]
         fn term_gradients_match_central_differences(
             jitter in proptest::collection::vec(-0.3f64..0.3, 8), scale in 0.5f64..2.0,
