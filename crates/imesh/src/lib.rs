@@ -1406,7 +1406,10 @@ impl Pipeline {
             let scale = (mean / median).clamp(1.0 / MAX_LATTICE_SCALE, MAX_LATTICE_SCALE);
             if median > 0.0 && (scale - 1.0).abs() > LATTICE_MATCH {
                 if let Ok(other) = remesh_with(scale) {
-                    if mean_shape_and_size(&other.mesh) > mean_shape_and_size(&r.mesh) {
+                    let (_, other_mean) = median_and_mean_area(&other.mesh);
+                    if mean_shape_and_size(&other.mesh, other_mean)
+                        > mean_shape_and_size(&r.mesh, mean)
+                    {
                         r = other;
                         counts.lattice_scale = scale;
                     }
@@ -1715,7 +1718,11 @@ pub const MAX_LATTICE_SCALE: f64 = 1.1;
 
 /// The median and the mean quad area of `mesh` (0 for no quad).
 fn median_and_mean_area(mesh: &imesh_quad::QuadMesh) -> (f64, f64) {
-    let mut areas: Vec<f64> = (0..mesh.quads.len()).map(|q| quad_area(mesh, q)).collect();
+    let mut areas: Vec<f64> = mesh
+        .quads
+        .iter()
+        .map(|quad| imesh_quality::quad::area(&corners(mesh, quad)))
+        .collect();
     if areas.is_empty() {
         return (0.0, 0.0);
     }
@@ -1725,22 +1732,17 @@ fn median_and_mean_area(mesh: &imesh_quad::QuadMesh) -> (f64, f64) {
     (*median, mean)
 }
 
-/// Quad `q`'s area (shoelace).
-fn quad_area(mesh: &imesh_quad::QuadMesh, q: usize) -> f64 {
-    let p = mesh.quads[q].map(|v| mesh.vertices[v as usize]);
-    0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y))
+/// The corners of `quad` of `mesh`, as the quality metrics take them.
+fn corners(mesh: &imesh_quad::QuadMesh, quad: &[u32; 4]) -> [[f64; 2]; 4] {
+    quad.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y])
 }
 
-/// The mean shape-and-size of `mesh`'s quads against their mean area.
-fn mean_shape_and_size(mesh: &imesh_quad::QuadMesh) -> f64 {
-    let (_, mean) = median_and_mean_area(mesh);
+/// The mean shape-and-size of `mesh`'s quads against their mean area, `mean`.
+fn mean_shape_and_size(mesh: &imesh_quad::QuadMesh, mean: f64) -> f64 {
     let sum: f64 = mesh
         .quads
         .iter()
-        .map(|quad| {
-            let p = quad.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
-            imesh_quality::quad::shape_and_size(&p, mean)
-        })
+        .map(|quad| imesh_quality::quad::shape_and_size(&corners(mesh, quad), mean))
         .sum();
     sum / mesh.quads.len().max(1) as f64
 }
