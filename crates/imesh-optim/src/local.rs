@@ -194,8 +194,7 @@ fn solve(
     let size = (area / scratch.corners.len() as f64).abs().sqrt();
     let (best, cost) = match setup.local_solver {
         LocalSolver::Powell => {
-            let powell = std::mem::replace(&mut scratch.powell, Powell::new(1.0));
-            scratch.powell = powell.with_initial_step(0.2 * size);
+            scratch.powell.set_initial_step(0.2 * size);
             let x = &mut scratch.x;
             x.clear();
             x.extend([0.0, 0.0]);

@@ -354,7 +354,7 @@ impl Powell {
     /// [`Powell::minimise_from`] moving `x` in place and returning its cost, with the solver's
     /// work vectors kept for the next call: for many small problems solved one after another,
     /// as the local optimiser's (the initial step is set for each by
-    /// [`Powell::with_initial_step`]).
+    /// [`Powell::set_initial_step`]).
     ///
     /// ```
     /// use imesh_optim::Powell;
@@ -391,12 +391,30 @@ impl Powell {
     /// The same solver with first line-search steps of `initial_step` (its work vectors kept).
     #[must_use]
     pub fn with_initial_step(mut self, initial_step: f64) -> Self {
+        self.set_initial_step(initial_step);
+        self
+    }
+
+    /// Sets the first line-search steps to `initial_step` (1 for a step that is not positive
+    /// and finite), keeping the work vectors: between the small problems of
+    /// [`Powell::minimise_in_place`].
+    ///
+    /// ```
+    /// use imesh_optim::Powell;
+    /// let mut powell = Powell::new(0.1);
+    /// // A scale a thousand times larger: the first steps follow it.
+    /// powell.set_initial_step(100.0);
+    /// let mut x = vec![0.0];
+    /// let far = |x: &Vec<f64>| (x[0] - 500.0).powi(2);
+    /// let f = powell.minimise_in_place(far, &mut x, far(&vec![0.0]), 50);
+    /// assert!((x[0] - 500.0).abs() < 1e-3 && f < 1e-6);
+    /// ```
+    pub fn set_initial_step(&mut self, initial_step: f64) {
         self.initial_step = if initial_step > 0.0 && initial_step.is_finite() {
             initial_step
         } else {
             1.0
         };
-        self
     }
 }
 

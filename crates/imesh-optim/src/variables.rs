@@ -29,7 +29,18 @@ impl<T> Rows<T> {
     }
 
     pub(crate) fn row(&self, i: usize) -> &[T] {
-        &self.items[self.first[i] as usize..self.first[i + 1] as usize]
+        &self.items[self.span(i)]
+    }
+
+    /// Row `i`, to change in place.
+    fn row_mut(&mut self, i: usize) -> &mut [T] {
+        let span = self.span(i);
+        &mut self.items[span]
+    }
+
+    /// Where row `i`'s items are in `items` (and in any list built item for item from them).
+    fn span(&self, i: usize) -> std::ops::Range<usize> {
+        self.first[i] as usize..self.first[i + 1] as usize
     }
 
     /// Number of rows.
@@ -62,15 +73,16 @@ impl<T: Copy> Rows<T> {
         Self { first, items }
     }
 
-    /// Keeps, in every row, the items `keep` says yes to (given the row and the item).
-    fn retain(&mut self, mut keep: impl FnMut(usize, &[T], usize) -> bool) {
+    /// Keeps, in every row, the items `keep` says yes to (given the row and the item's place
+    /// in it).
+    fn retain(&mut self, mut keep: impl FnMut(&[T], usize) -> bool) {
         let mut items = Vec::with_capacity(self.items.len());
         let mut first = Vec::with_capacity(self.first.len());
         first.push(0);
         for r in 0..self.len() {
             let row = self.row(r);
             for k in 0..row.len() {
-                if keep(r, row, k) {
+                if keep(row, k) {
                     items.push(row[k]);
                 }
             }
@@ -245,10 +257,9 @@ impl Variables {
         // A vertex on a side shared by two patches appears in both, with the same weight: the
         // first is kept, and the rows sorted by vertex.
         for r in 0..influence.len() {
-            let (a, b) = (influence.first[r] as usize, influence.first[r + 1] as usize);
-            influence.items[a..b].sort_by_key(|&(v, _)| v);
+            influence.row_mut(r).sort_by_key(|&(v, _)| v);
         }
-        influence.retain(|_, row, k| k == 0 || row[k].0 != row[k - 1].0);
+        influence.retain(|row, k| k == 0 || row[k].0 != row[k - 1].0);
         // Control points that move exactly the same quad vertices are one degree of freedom
         // solved several times: at level 1 a quad patch's four inner points all move only its
         // centre, and an edge's two inner points the same midpoint and centres. The first of
@@ -256,9 +267,7 @@ impl Variables {
         let keys: Vec<u32> = influence.items.iter().map(|&(v, _)| v).collect();
         let mut seen = std::collections::HashSet::new();
         let keep: Vec<bool> = (0..influence.len())
-            .map(|r| {
-                seen.insert(&keys[influence.first[r] as usize..influence.first[r + 1] as usize])
-            })
+            .map(|r| seen.insert(&keys[influence.span(r)]))
             .collect();
         let ids = ids
             .into_iter()
@@ -428,7 +437,7 @@ mod tests {
             for (r, list) in expected.iter().enumerate() {
                 prop_assert_eq!(kept.row(r), &list[..]);
             }
-            rows.retain(|_, row, k| row[k] % 2 == 0);
+            rows.retain(|row, k| row[k] % 2 == 0);
             for (r, list) in lists.iter().enumerate() {
                 let even: Vec<u16> = list.iter().copied().filter(|x| x % 2 == 0).collect();
                 prop_assert_eq!(rows.row(r), &even[..]);
