@@ -160,13 +160,12 @@ pub fn adapt(
             bar[x] = POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9;
         }
     }
-    for &index in &touched {
-        q.evaluate_element(m, net, index);
-    }
-    let needs_repair = |q: &QuadMesh, index: usize| {
-        q.element_quads(index)
-            .any(|x| !q.is_valid(x) || q.scaled_jacobian(x) < bar[x])
-    };
+    // Per call of `evaluate`, which M edges it has evaluated.
+    let mut edge_stamp = vec![0u32; m.edges.len()];
+    let mut stamp = 1;
+    evaluate(q, m, net, &touched, &mut edge_stamp, stamp);
+    let needs_repair =
+        |q: &QuadMesh, index: usize| q.element_quads(index).any(|x| !q.is_valid_above(x, bar[x]));
     let mut bad: Vec<usize> = touched
         .into_iter()
         .filter(|&i| needs_repair(q, i))
@@ -181,12 +180,17 @@ pub fn adapt(
         if bad.is_empty() {
             break;
         }
+        // The round's elements: the first round's bad ones were evaluated above; later rounds'
+        // had a side or a corner moved by a damped curve.
+        if round > 1 {
+            stamp += 1;
+            evaluate(q, m, net, &bad, &mut edge_stamp, stamp);
+        }
         for &index in &bad {
             net.relax_inner(&m.elements[index], index);
-            q.evaluate_element(m, net, index);
+            q.evaluate_inside(m, net, index);
             relaxed[index] = true;
         }
-        let mut next = Vec::new();
         let still: Vec<usize> = bad
             .iter()
             .copied()
@@ -203,8 +207,13 @@ pub fn adapt(
                 .iter()
                 .map(|&v| curve_of_vertex[v as usize])
                 .filter(|&k| k != NONE);
-            let touching: Vec<u32> = sides.chain(corners).collect();
-            for k in touching {
+            let mut touching = [NONE; 8];
+            let mut count = 0;
+            for k in sides.chain(corners) {
+                touching[count] = k;
+                count += 1;
+            }
+            for &k in &touching[..count] {
                 let k = k as usize;
                 if weight[k] == 0.0 || curve_round[k] == round {
                     continue;
@@ -235,9 +244,8 @@ pub fn adapt(
                         .chain(around(t.destination(h)))
                     {
                         if let Some(&el) = m.element_of_triangle.get(f.index()) {
-                            if el != NONE && element_round[el as usize] != round {
+                            if el != NONE {
                                 element_round[el as usize] = round;
-                                next.push(el as usize);
                             }
                         }
                     }
@@ -245,17 +253,38 @@ pub fn adapt(
             }
         }
         // Every element a damped curve moved (its sides, or a corner) is relaxed and evaluated
-        // again at the start of the next round, before any check.
-        bad = next;
+        // again at the start of the next round, before any check; in element order, which is
+        // the order of their control points and template vertices in memory.
+        bad.clear();
+        bad.extend((0..m.elements.len()).filter(|&el| element_round[el] == round));
     }
     // Unless the rounds ran out first.
-    for &index in &bad {
-        q.evaluate_element(m, net, index);
-    }
+    evaluate(q, m, net, &bad, &mut edge_stamp, stamp + 1);
     report.relaxed_patches = relaxed.iter().filter(|&&r| r).count();
     report.damped_curves = damped.iter().filter(|&&d| d).count();
     report.invalid_left = (0..q.quads.len()).filter(|&x| !q.is_valid(x)).count();
     (report, adapted)
+}
+
+/// Re-evaluates the vertices of `elements` from their patches: each M edge they have once
+/// (marked with `stamp` in `edge_stamp`), then their inner points.
+fn evaluate(
+    q: &mut QuadMesh,
+    m: &ElementMesh,
+    net: &ControlNet,
+    elements: &[usize],
+    edge_stamp: &mut [u32],
+    stamp: u32,
+) {
+    for &index in elements {
+        for side in 0..m.side_count(index) {
+            let e = m.side_edge(index, side).0;
+            if std::mem::replace(&mut edge_stamp[e as usize], stamp) != stamp {
+                q.evaluate_edge(net, e);
+            }
+        }
+        q.evaluate_inside(m, net, index);
+    }
 }
 
 /// The curve parameter of every Steiner vertex on a G' edge: that of its closest point on the
@@ -275,18 +304,21 @@ fn curve_parameters(dt: &RegionTriangulation, g: &CurveGraph, curves: &[CubicBez
         };
         let chain = dt.segment_pieces(imesh_geom::SegmentId(s as u32));
         let straight: Vec<f64> = chain.iter().map(|&v| dt.edge_parameter(g, k, v)).collect();
-        let mut projected: Vec<f64> = chain
+        let n = chain.len();
+        // The ends are the curve's ends, whichever way the segment was inserted; only the
+        // Steiner vertices between them are projected.
+        let projected: Vec<f64> = chain
             .iter()
             .zip(&straight)
-            .map(|(&v, &u)| curve.closest_parameter(t.point(v), u))
+            .enumerate()
+            .map(|(i, (&v, &u))| {
+                if i == 0 || i + 1 == n {
+                    u.round()
+                } else {
+                    curve.closest_parameter(t.point(v), u)
+                }
+            })
             .collect();
-        let n = chain.len();
-        if n >= 2 {
-            // The ends are the curve's ends, whichever way the segment was inserted.
-            let (first, last) = (straight[0], straight[n - 1]);
-            projected[0] = first.round();
-            projected[n - 1] = last.round();
-        }
         let increasing = straight.first() <= straight.last();
         let ordered = projected
             .windows(2)

@@ -42,6 +42,13 @@ pub struct QuadMesh {
     templates: Box<[Template; 2]>,
     /// The template level.
     level: u32,
+    /// The cubic Bernstein weights of the template points along an M edge, at `along / 2k` for
+    /// `along` = 1 … 2k − 1 (index `along − 1`).
+    along_edge: Vec<[f64; 4]>,
+    /// The ends of each M edge, from its origin.
+    edge_ends: Vec<[u32; 2]>,
+    /// Per template (triangle, quad), its inner points (template order).
+    inside_places: [Vec<u32>; 2],
 }
 
 impl QuadMesh {
@@ -56,12 +63,15 @@ impl QuadMesh {
         let nv = t.num_vertices() as u32;
         let per_edge = 2 * k - 1;
         let inside_base = nv + per_edge * m.edges.len() as u32;
-        let mut quads = Vec::new();
-        let mut labels = Vec::new();
-        let mut parents = Vec::new();
-        let mut point_first = vec![0u32];
-        let mut points = Vec::new();
-        let mut quad_first = vec![0u32];
+        let quad_count = m.quad_count(k) as usize;
+        let mut quads = Vec::with_capacity(quad_count);
+        let mut labels = Vec::with_capacity(quad_count);
+        let mut parents = Vec::with_capacity(quad_count);
+        let mut point_first = Vec::with_capacity(m.elements.len() + 1);
+        point_first.push(0u32);
+        let mut points = Vec::with_capacity(m.elements.len() * templates[1].places.len());
+        let mut quad_first = Vec::with_capacity(m.elements.len() + 1);
+        quad_first.push(0u32);
         let mut next_inside = inside_base;
         for (index, element) in m.elements.iter().enumerate() {
             let tp = template(element);
@@ -128,10 +138,28 @@ impl QuadMesh {
             quad_first,
             corner_count: nv,
             level: k,
+            along_edge: (1..2 * k)
+                .map(|along| crate::patch::bernstein3(f64::from(along) / f64::from(2 * k)))
+                .collect(),
+            edge_ends: m
+                .edges
+                .iter()
+                .map(|&h| [t.origin(h), t.destination(h)].map(|v| v.index() as u32))
+                .collect(),
+            inside_places: templates.each_ref().map(|tp| {
+                (0u32..)
+                    .zip(&tp.places)
+                    .filter(|(_, place)| matches!(place, Place::Inside(_)))
+                    .map(|(i, _)| i)
+                    .collect()
+            }),
             templates: Box::new(templates),
         };
+        for e in 0..m.edges.len() as u32 {
+            mesh.evaluate_edge(net, e);
+        }
         for index in 0..m.elements.len() {
-            mesh.evaluate_element(m, net, index);
+            mesh.evaluate_inside(m, net, index);
         }
         mesh
     }
@@ -213,19 +241,58 @@ impl QuadMesh {
         self.quad_first[index] as usize..self.quad_first[index + 1] as usize
     }
 
-    /// Re-evaluates the vertices of element `index` from its patch.
+    /// Re-evaluates the vertices of element `index` from its patch: its sides' M edges
+    /// ([`QuadMesh::evaluate_edge`]) and its inner points ([`QuadMesh::evaluate_inside`]).
     pub fn evaluate_element(&mut self, m: &ElementMesh, net: &ControlNet, index: usize) {
-        let element = &m.elements[index];
-        let template = &self.templates[usize::from(matches!(element, Element::Quad(_)))];
-        let first = self.point_first[index] as usize;
-        for (i, (terms, place)) in template.terms.iter().zip(&template.places).enumerate() {
-            let v = self.points[first + i] as usize;
-            self.vertices[v] = match *place {
-                Place::Side { side, .. } => {
-                    net.eval_terms_on_side(element, index, terms, side as usize)
-                }
-                _ => net.eval_terms(index, terms),
-            };
+        for side in 0..m.side_count(index) {
+            self.evaluate_edge(net, m.side_edge(index, side).0);
+        }
+        self.evaluate_inside(m, net, index);
+    }
+
+    /// Re-evaluates the vertices along M edge `e` (its ends and its `2k − 1` template points)
+    /// from its four control points: the cubic Bézier of the edge, in the edge's own direction,
+    /// which is every patch that has the edge restricted to it. A vertex shared by two
+    /// elements thus has the same bits whichever of them is evaluated, and last.
+    pub fn evaluate_edge(&mut self, net: &ControlNet, e: u32) {
+        let [a, b] = self.edge_ends[e as usize].map(|v| v as usize);
+        let [i, j] = net.edge_inner(e).map(|c| c as usize);
+        let control = [net.points[a], net.points[i], net.points[j], net.points[b]];
+        self.vertices[a] = control[0];
+        self.vertices[b] = control[3];
+        // Exact on axis-parallel straight edges (the domain border, pixel-aligned boundaries),
+        // whatever the rounding of the sum.
+        let same_x = control.iter().all(|p| p.x == control[0].x);
+        let same_y = control.iter().all(|p| p.y == control[0].y);
+        let per_edge = 2 * self.level - 1;
+        let base = (self.corner_count + per_edge * e) as usize;
+        for (v, w) in self.vertices[base..base + per_edge as usize]
+            .iter_mut()
+            .zip(&self.along_edge)
+        {
+            let (mut x, mut y) = (0.0, 0.0);
+            for (w, p) in w.iter().zip(&control) {
+                x += w * p.x;
+                y += w * p.y;
+            }
+            if same_x {
+                x = control[0].x;
+            }
+            if same_y {
+                y = control[0].y;
+            }
+            *v = Point::new(x, y);
+        }
+    }
+
+    /// Re-evaluates the inner template points of element `index` (those on no side) from its
+    /// patch: all that changes when only its inner control points move.
+    pub fn evaluate_inside(&mut self, m: &ElementMesh, net: &ControlNet, index: usize) {
+        let kind = usize::from(matches!(m.elements[index], Element::Quad(_)));
+        let ids = &self.points[self.point_first[index] as usize..];
+        let terms = &self.templates[kind].terms;
+        for &i in &self.inside_places[kind] {
+            self.vertices[ids[i as usize] as usize] = net.eval_terms(index, &terms[i as usize]);
         }
     }
 
@@ -240,6 +307,37 @@ impl QuadMesh {
         scaled_jacobian(&self.quads[q].map(|v| self.vertices[v as usize]))
     }
 
+    /// True when quad `q` is valid ([`QuadMesh::is_valid`]) and its scaled Jacobian is at least
+    /// `floor`: the same answer as both tests, with the exact one only for a quad whose scaled
+    /// Jacobian is under [`SURE_JACOBIAN`].
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// use imesh_quad::{ControlNet, ElementMesh, Pairing, QuadMesh};
+    /// let square = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)].map(Point::from);
+    /// let (t, _) = Triangulation::from_points(&square)?;
+    /// let m = ElementMesh::pair(&t, Pairing::Greedy);
+    /// let q = QuadMesh::build(&t, &m, &ControlNet::straight(&t, &m), 1);
+    /// assert!(q.is_valid_above(0, 0.99)); // a square: every corner's sine is 1
+    /// # Ok::<(), imesh_geom::GeomError>(())
+    /// ```
+    pub fn is_valid_above(&self, q: usize, floor: f64) -> bool {
+        if floor < SURE_JACOBIAN {
+            let jacobian = self.scaled_jacobian(q);
+            return jacobian >= floor && (jacobian >= SURE_JACOBIAN || self.is_valid(q));
+        }
+        // A positive floor: every corner's sine `α / (|a| |b|)` at least `floor`, squared to
+        // spare the roots and divisions (the same test up to a rounding of the last bit).
+        let p = self.quads[q].map(|v| self.vertices[v as usize]);
+        let floor2 = floor * floor;
+        (0..4).all(|i| {
+            let (a, b) = (p[(i + 1) % 4] - p[i], p[(i + 3) % 4] - p[i]);
+            let cross = a.x * b.y - a.y * b.x;
+            cross > 0.0
+                && cross * cross >= floor2 * ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y))
+        })
+    }
+
     /// The total (signed) area of the quads.
     pub fn area(&self) -> f64 {
         self.quads
@@ -252,6 +350,12 @@ impl QuadMesh {
             .sum()
     }
 }
+
+/// A quad whose scaled Jacobian (as computed) is at least this is valid without the exact
+/// test: at every corner the computed cross product `a × b` is then at least `10⁻¹⁰ |a| |b|`,
+/// some 10⁵ times the bound on its rounding error (a few ε times `|aₓ b_y| + |a_y bₓ|`, itself at
+/// most `2 |a| |b|`), so the exact orientation is positive too.
+pub const SURE_JACOBIAN: f64 = 1e-10;
 
 /// The scaled Jacobian of the quad `p`: the least sine of its corner angles, signed (Verdict's
 /// definition for a counter-clockwise quad; negative at a reflex corner). 0 for a quad with a

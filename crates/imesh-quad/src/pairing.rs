@@ -113,9 +113,9 @@ impl ElementMesh {
 
     fn from_partners(t: &Triangulation, partner: &[u32]) -> Self {
         let slots = t.num_triangle_slots();
-        let mut elements = Vec::new();
-        let mut labels = Vec::new();
-        let mut sides = Vec::new();
+        let mut elements = Vec::with_capacity(slots);
+        let mut labels = Vec::with_capacity(slots);
+        let mut sides = Vec::with_capacity(slots);
         let mut unpaired = 0;
         let mut diagonal = vec![false; 3 * slots];
         let mut element_of_triangle = vec![NONE; slots];
@@ -152,7 +152,7 @@ impl ElementMesh {
             labels.push(t.label(f));
         }
         let mut edge_of_half = vec![NONE; 3 * slots];
-        let mut edges = Vec::new();
+        let mut edges = Vec::with_capacity(2 * slots);
         for h in t.edges() {
             if diagonal[h.index()] {
                 continue;
@@ -194,6 +194,15 @@ fn strictly_convex(q: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(q[(i + 3) % 4], q[i], q[(i + 1) % 4]) > 0.0)
 }
 
+/// Sorts `(key, half-edge)` pairs by decreasing key, then increasing half-edge: the order of
+/// the paper's max-heap, made deterministic. The keys are lengths and corner sines, never
+/// negative, so their bits sort as they do, and the pairs are all distinct: an unstable sort
+/// on integers gives the one order, without a comparator's branches.
+fn sort_best_first(candidates: &mut [(f64, HalfEdgeId)]) {
+    debug_assert!(candidates.iter().all(|&(key, _)| key >= 0.0));
+    candidates.sort_unstable_by_key(|&(key, h)| (std::cmp::Reverse(key.to_bits()), h.index()));
+}
+
 fn pair_up(partner: &mut [u32], f: TriangleId, n: TriangleId) {
     partner[f.index()] = n.index() as u32;
     partner[n.index()] = f.index() as u32;
@@ -214,7 +223,7 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
             (a.distance_squared(b), h)
         })
         .collect();
-    candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.index().cmp(&y.1.index())));
+    sort_best_first(&mut candidates);
     let mut partner = vec![NONE; t.num_triangle_slots()];
     let mut marked = vec![false; 3 * t.num_triangle_slots()];
     for (_, h) in candidates {
@@ -276,7 +285,7 @@ fn matching(t: &Triangulation) -> Vec<u32> {
     };
     let mut candidates: Vec<(f64, HalfEdgeId)> =
         t.edges().filter_map(|h| good(h).map(|w| (w, h))).collect();
-    candidates.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.index().cmp(&y.1.index())));
+    sort_best_first(&mut candidates);
     let mut partner = vec![NONE; t.num_triangle_slots()];
     for &(_, h) in &candidates {
         let (f, Some(n)) = (t.triangle_of(h), t.neighbour(h)) else {

@@ -56,8 +56,9 @@ impl ControlNet {
     /// a uniform grid, so that every patch is exactly its straight element.
     pub fn straight(t: &Triangulation, m: &ElementMesh) -> Self {
         let nv = t.num_vertices();
-        let mut points: Vec<Point> = t.points().to_vec();
-        points.truncate(nv);
+        let mut points: Vec<Point> =
+            Vec::with_capacity(nv + 2 * m.edges.len() + 4 * m.elements.len());
+        points.extend_from_slice(&t.points()[..nv]);
         let edge_base = points.len() as u32;
         for &h in &m.edges {
             let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
@@ -116,43 +117,6 @@ impl ControlNet {
             Element::Quad(_) => QUAD_SIDES[side],
         };
         along.map(|slot| self.points[self.patches[k][slot] as usize])
-    }
-
-    /// The point of element `k`'s patch for the basis `weights`, exact on axis-parallel
-    /// straight sides: a point on side `side` whose four control points share a coordinate gets
-    /// that coordinate exactly (so that the domain border and pixel-aligned boundaries stay
-    /// exact, whatever the rounding of the patch sum).
-    pub fn eval_on_side(
-        &self,
-        element: &Element,
-        k: usize,
-        weights: &[f64; 16],
-        side: usize,
-    ) -> Point {
-        self.snap_to_side(element, k, side, self.eval_weights(k, weights))
-    }
-
-    /// [`ControlNet::eval_on_side`] for the nonzero weights only (`(slot, weight)` in slot
-    /// order, as [`crate::Template::terms`] has them): the same point.
-    pub fn eval_terms_on_side(
-        &self,
-        element: &Element,
-        k: usize,
-        terms: &[(u8, f64)],
-        side: usize,
-    ) -> Point {
-        self.snap_to_side(element, k, side, self.eval_terms(k, terms))
-    }
-
-    fn snap_to_side(&self, element: &Element, k: usize, side: usize, mut p: Point) -> Point {
-        let c = self.side_points(element, k, side);
-        if c.iter().all(|q| q.x == c[0].x) {
-            p.x = c[0].x;
-        }
-        if c.iter().all(|q| q.y == c[0].y) {
-            p.y = c[0].y;
-        }
-        p
     }
 
     /// The inner control points of M edge `e` (at 1/3 and 2/3 along its direction).
@@ -262,7 +226,7 @@ pub fn basis(quad: bool, uv: [f64; 2]) -> [f64; 16] {
 const TRIANGLE_COEFFICIENTS: [f64; 10] = [1.0, 3.0, 3.0, 1.0, 3.0, 6.0, 3.0, 3.0, 3.0, 1.0];
 
 /// The cubic Bernstein polynomials at `t`.
-fn bernstein3(t: f64) -> [f64; 4] {
+pub(crate) fn bernstein3(t: f64) -> [f64; 4] {
     let s = 1.0 - t;
     [s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t]
 }

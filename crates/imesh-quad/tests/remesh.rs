@@ -384,6 +384,81 @@ fn bad_options_are_typed_errors() {
 /// On the side `u + v = 1` of the canonical triangle, only the side's four control points weigh
 /// anything, exactly: a non-zero rounding weight (1e-17) on an inner point let the optimiser move
 /// a border vertex off the border at level 3 (fuzz/regressions/pipeline).
+/// A vertex on an M edge is the edge's own Bézier, not a sum over one of the two patches that
+/// share it: after adaptation (curved edges, relaxed patches) evaluating the elements in any
+/// order gives the mesh's vertices to the bit.
+#[test]
+fn shared_vertices_do_not_depend_on_the_order_of_evaluation() {
+    let c = curves(&support::fixture("stardist-mask2d_labels.png"));
+    for level in [1, 2] {
+        let r = run(
+            &c,
+            &QuadOptions {
+                level,
+                ..Default::default()
+            },
+        );
+        assert!(r.adaptation.adapted_edges > 0 && r.adaptation.relaxed_patches > 0);
+        let n = r.elements.elements.len();
+        for order in [
+            (0..n).collect::<Vec<_>>(),
+            (0..n).rev().collect(),
+            (0..n).map(|i| (i * 7919) % n).collect(),
+        ] {
+            let mut q = r.mesh.clone();
+            q.vertices
+                .iter_mut()
+                .for_each(|p| *p = Point::new(f64::NAN, f64::NAN));
+            for &k in &order {
+                q.evaluate_element(&r.elements, &r.net, k);
+            }
+            for (v, (a, b)) in q.vertices.iter().zip(&r.mesh.vertices).enumerate() {
+                assert!(
+                    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits(),
+                    "level {level}, vertex {v}: {a:?} evaluated vs {b:?} in the mesh"
+                );
+            }
+        }
+    }
+}
+
+proptest::proptest! {
+    /// The squared test of `is_valid_above` answers as the exact validity test and the scaled
+    /// Jacobian do, on random quads (convex, flat, reflex, folded) and floors, away from ties.
+    #[test]
+    fn is_valid_above_is_validity_and_the_scaled_jacobian(
+        corners in proptest::collection::vec((-0.45f64..0.45, -0.45f64..0.45), 4),
+        offset in -1e4f64..1e4,
+        scale in 1e-3f64..1e3,
+        floor in -1.0f64..1.0,
+    ) {
+        let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let p: Vec<Point> = (0..4)
+            .map(|i| Point::new(
+                offset + scale * (square[i].0 + corners[i].0),
+                offset + scale * (square[i].1 + corners[i].1),
+            ))
+            .collect();
+        let triangle = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].map(Point::from);
+        let (t, _) = imesh_geom::Triangulation::from_points(&triangle).unwrap();
+        let m = imesh_quad::ElementMesh::pair(&t, imesh_quad::Pairing::Greedy);
+        let net = imesh_quad::ControlNet::straight(&t, &m);
+        let mut q = imesh_quad::QuadMesh::build(&t, &m, &net, 1);
+        // One quad of the mesh, its corners replaced by the random quad's.
+        let ids = q.quads[0];
+        for (i, &v) in ids.iter().enumerate() {
+            q.vertices[v as usize] = p[i];
+        }
+        let jacobian = q.scaled_jacobian(0);
+        proptest::prop_assume!((jacobian - floor).abs() > 1e-12);
+        proptest::prop_assert_eq!(
+            q.is_valid_above(0, floor),
+            q.is_valid(0) && jacobian >= floor,
+            "{:?}: scaled Jacobian {}, floor {}", p, jacobian, floor
+        );
+    }
+}
+
 #[test]
 fn a_triangle_side_depends_on_its_own_control_points_only() {
     for k in 1..=8 {
