@@ -3,7 +3,8 @@
 //! 512 × 512, Otsu: thousands of blades; 50 282 triangles, the paper's graded DT').
 //!
 //! `cargo bench -p imesh-quad`. Goal (issue 7): pairing + templates + adaptation in < 50 ms for
-//! 10^5 triangles, so < 25 ms here.
+//! 10^5 triangles, so < 25 ms here; the last group is the same boundaries refined to about
+//! 10^5 triangles.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -71,6 +72,50 @@ fn bench(c: &mut Criterion) {
             black_box(adapt(&dt, &s.graph, &curves, &elements, &mut net, &mut q))
         })
     });
+    group.finish();
+
+    // The issue's own size: the same boundaries refined to no triangle larger than the
+    // equilateral one of 3.2 px, about 10^5 triangles.
+    let fine = RegionTriangulation::new(
+        &s.graph,
+        &DensityOptions {
+            max_size: Some(3.2),
+            ..DensityOptions::default()
+        },
+    )
+    .expect("DT' builds");
+    let triangles = fine.triangulation.num_triangles();
+    {
+        let t0 = std::time::Instant::now();
+        let elements = ElementMesh::pair(&fine.triangulation, Pairing::Greedy);
+        let t1 = t0.elapsed();
+        let mut net = ControlNet::straight(&fine.triangulation, &elements);
+        let mut q = QuadMesh::build(&fine.triangulation, &elements, &net, 1);
+        let t2 = t0.elapsed();
+        let (report, _) = adapt(&fine, &s.graph, &curves, &elements, &mut net, &mut q);
+        eprintln!(
+            "max size 3.2: {triangles} triangles, {} quads, {} unpaired; pairing {t1:?}, templates {:?}, adaptation {:?} in {:?}",
+            q.quads.len(),
+            elements.unpaired,
+            t2 - t1,
+            report,
+            t0.elapsed() - t2
+        );
+    }
+    let mut group = c.benchmark_group("quad stage grass, max size 3.2 px");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(triangles as u64));
+    group.bench_function(
+        format!("pair + patches + templates + adaptation, {triangles} triangles"),
+        |b| {
+            b.iter(|| {
+                let elements = ElementMesh::pair(&fine.triangulation, Pairing::Greedy);
+                let mut net = ControlNet::straight(&fine.triangulation, &elements);
+                let mut q = QuadMesh::build(&fine.triangulation, &elements, &net, 1);
+                black_box(adapt(&fine, &s.graph, &curves, &elements, &mut net, &mut q))
+            })
+        },
+    );
     group.finish();
 }
 
