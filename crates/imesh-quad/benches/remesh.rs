@@ -11,8 +11,10 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use imesh_classify::{luminance, multi_otsu_levels, threshold};
+use imesh_curves::{CubicBezier, CurveGraph};
 use imesh_quad::{
-    adapt, ControlNet, DensityOptions, ElementMesh, Pairing, QuadMesh, RegionTriangulation,
+    adapt, AdaptReport, ControlNet, DensityOptions, ElementMesh, Pairing, QuadMesh,
+    RegionTriangulation,
 };
 
 // The c-edge graph of a label grid, as imesh-curves' tests build it.
@@ -65,12 +67,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.bench_function("pair + patches + templates + adaptation (the goal)", |b| {
-        b.iter(|| {
-            let elements = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
-            let mut net = ControlNet::straight(&dt.triangulation, &elements);
-            let mut q = QuadMesh::build(&dt.triangulation, &elements, &net, 1);
-            black_box(adapt(&dt, &s.graph, &curves, &elements, &mut net, &mut q))
-        })
+        b.iter(|| black_box(quad_stage(&dt, &s.graph, &curves)))
     });
     group.finish();
 
@@ -107,16 +104,22 @@ fn bench(c: &mut Criterion) {
     group.throughput(Throughput::Elements(triangles as u64));
     group.bench_function(
         format!("pair + patches + templates + adaptation, {triangles} triangles"),
-        |b| {
-            b.iter(|| {
-                let elements = ElementMesh::pair(&fine.triangulation, Pairing::Greedy);
-                let mut net = ControlNet::straight(&fine.triangulation, &elements);
-                let mut q = QuadMesh::build(&fine.triangulation, &elements, &net, 1);
-                black_box(adapt(&fine, &s.graph, &curves, &elements, &mut net, &mut q))
-            })
-        },
+        |b| b.iter(|| black_box(quad_stage(&fine, &s.graph, &curves))),
     );
     group.finish();
+}
+
+/// The measured path: pairing (greedy), straight patches, level-1 templates, adaptation.
+fn quad_stage(
+    dt: &RegionTriangulation,
+    graph: &CurveGraph,
+    curves: &[CubicBezier],
+) -> (QuadMesh, AdaptReport) {
+    let elements = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+    let mut net = ControlNet::straight(&dt.triangulation, &elements);
+    let mut q = QuadMesh::build(&dt.triangulation, &elements, &net, 1);
+    let (report, _) = adapt(dt, graph, curves, &elements, &mut net, &mut q);
+    (q, report)
 }
 
 criterion_group!(benches, bench);
