@@ -58,7 +58,7 @@ pub use energy::{is_valid, Metric};
 
 use energy::worst_corner;
 pub use powell::Powell;
-pub use repair::REPAIR_JACOBIAN;
+pub use repair::{REPAIR_FLOOR, REPAIR_JACOBIAN};
 
 use std::time::Instant;
 
@@ -163,9 +163,11 @@ pub struct OptimOptions {
     /// After the local or the vertex mode (and the sliding): every free quad vertex within two
     /// rings of a quad whose scaled Jacobian or shape is under [`REPAIR_JACOBIAN`] moves, by
     /// compass search, to raise the smallest scaled Jacobian of its quads, then their smallest
-    /// shape (up to that bar), every quad held to the same floors; undone if it would leave the
-    /// energy above the start's. The energy leaves such quads where their shape-and-size is
-    /// fair. Measured with the defaults: worst scaled Jacobian stardist 0.272 → 0.355, coffee
+    /// shape (up to that bar), every quad held to [`REPAIR_FLOOR`] or its own values if lower;
+    /// then the free corners of each quad still under the bar move two or more at a time;
+    /// undone if it would leave the energy above the start's. The energy leaves such quads
+    /// where their shape-and-size is fair. Measured with the defaults (a bar of 0.4 and the
+    /// descent's floors then): worst scaled Jacobian stardist 0.272 → 0.355, coffee
     /// 0.251 → 0.280, grass 0.280 → 0.299, MRI 0.352 → 0.371, camera 0.358 → 0.383; worst shape
     /// stardist 0.232 → 0.312, coffee 0.192 → 0.224, grass 0.068 → 0.119, gravel 0.075 →
     /// 0.155; the other values equal; mean shape-and-size within 0.001; 0.5–4 % of the
@@ -519,13 +521,29 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     };
     let repaired = if options.repair && matches!(options.method, Method::Local | Method::Vertex) {
         let descended = mesh.vertices.clone();
-        // The repair trades a quad's size for the corners of its neighbours: it keeps the
-        // floors of shape and scaled Jacobian, but of the metric only the start's worst (held
-        // to each quad's own, it left grass's worst shape 0.136 → 0.106 and stardist's 0.312 →
-        // 0.302).
+        // The repair trades a quad's size for the corners of its neighbours: of the metric it
+        // keeps only the start's worst (held to each quad's own, it left grass's worst shape
+        // 0.136 → 0.106 and stardist's 0.312 → 0.302); a quad's shape and scaled Jacobian may
+        // fall to REPAIR_FLOOR, never below where they are now, so the worst of neither falls.
         let loose = vec![worst; quads.len()];
+        let (shape_now, jacobian_now): (Vec<f64>, Vec<f64>) = quads
+            .par_iter()
+            .map(|q| {
+                let p = q.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
+                (
+                    imesh_quality::quad::shape(&p)
+                        .min(REPAIR_FLOOR)
+                        .max(before.shape.min),
+                    imesh_quality::quad::scaled_jacobian(&p)
+                        .min(REPAIR_FLOOR)
+                        .max(before.scaled_jacobian.min),
+                )
+            })
+            .unzip();
         let repair_setup = Setup {
             quality_floors: &loose,
+            shape_floors: &shape_now,
+            jacobian_floors: &jacobian_now,
             ..setup
         };
         let moved = repair::repair(t, elements, mesh, &repair_setup, REPAIR_JACOBIAN);

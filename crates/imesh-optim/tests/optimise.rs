@@ -3,7 +3,7 @@
 
 use imesh_classify::LabelGrid;
 use imesh_geom::Point;
-use imesh_optim::{optimise, LocalSolver, Method, Metric, OptimOptions, OptimReport};
+use imesh_optim::{optimise, LocalSolver, Method, Metric, OptimOptions, OptimReport, REPAIR_FLOOR};
 use imesh_quad::{remesh, QuadOptions, Remesh};
 use proptest::prelude::*;
 
@@ -167,7 +167,13 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
             before.min,
             after.min
         );
-        // No quad ends below its own start shape or 0.5 (`keep_shape`), whichever is lower.
+        // No quad ends below its own start shape or 0.5 (`keep_shape`), whichever is lower, or
+        // REPAIR_FLOOR where the repair ran.
+        let repair_floor = if options.repair && matches!(method, Method::Local | Method::Vertex) {
+            REPAIR_FLOOR
+        } else {
+            1.0
+        };
         for (q, quad) in r.mesh.quads.iter().enumerate() {
             let shape = |m: &Remesh| {
                 imesh_quality::quad::shape(&quad.map(|v| {
@@ -175,7 +181,7 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
                     [p.x, p.y]
                 }))
             };
-            let floor = shape(start).min(options.keep_shape);
+            let floor = shape(start).min(options.keep_shape).min(repair_floor);
             assert!(
                 shape(&r) >= floor,
                 "{method:?}: quad {q} shape {} < {floor}",
@@ -434,9 +440,10 @@ fn repair_raises_the_worst_corners() {
     assert!(with.repaired > 0);
     assert!(with.after.scaled_jacobian.min > without.after.scaled_jacobian.min);
     assert!(with.after.shape.min >= without.after.shape.min);
-    // Shape-and-size pays little for it (this graded mesh's sizes vary a hundredfold: 1.6 %;
-    // the uniform default meshes of the fixtures lose 0.1 % at most).
-    assert!(with.after.shape_and_size.mean > without.after.shape_and_size.mean * 0.98);
+    // Shape-and-size pays little for it (this graded mesh's sizes vary a hundredfold, and a
+    // third of its quads are under the bar: 3.2 %; the uniform default meshes of the fixtures
+    // lose 0.1 % at most).
+    assert!(with.after.shape_and_size.mean > without.after.shape_and_size.mean * 0.96);
 }
 
 /// Every quad's shape-and-size against `average` area.

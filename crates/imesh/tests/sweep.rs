@@ -55,7 +55,11 @@ fn options() -> impl Strategy<Value = MeshOptions> {
         prop::option::of(10.0..33.0f64),
         prop::option::of(2.0..24.0f64),
         1u32..=3,
-        prop::sample::select(vec![PairingMethod::Matching, PairingMethod::Greedy]),
+        prop::sample::select(vec![
+            PairingMethod::Matching,
+            PairingMethod::Fewest,
+            PairingMethod::Greedy,
+        ]),
         prop::sample::select(vec![
             OptimizerMethod::Local,
             OptimizerMethod::Global,
