@@ -47,6 +47,30 @@ pub(crate) fn area(p: &[Point; 4]) -> f64 {
     0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y))
 }
 
+/// Verdict's shape of the quad `p`, as the optimiser computes it millions of times: for a
+/// counter-clockwise quad the same operations in the same order as
+/// [`imesh_quality::quad::shape`], so the same bits, without the tests only a degenerate or
+/// clockwise quad needs (an edge under 10⁻⁷ of the quad's size, where this gives a shape under
+/// 10⁻⁷ and Verdict 0; a clockwise quad, which this scores 0 and Verdict by its mirror image:
+/// the optimiser rejects both).
+#[inline]
+pub(crate) fn shape(p: &[Point; 4]) -> f64 {
+    let e = [p[1] - p[0], p[2] - p[1], p[3] - p[2], p[0] - p[3]];
+    let len2 = e.map(|v| v.x * v.x + v.y * v.y);
+    let cross = |a: Point, b: Point| a.x * b.y - a.y * b.x;
+    let mut worst = cross(e[3], e[0]) / (len2[0] + len2[3]);
+    worst = worst.min(cross(e[0], e[1]) / (len2[1] + len2[0]));
+    worst = worst.min(cross(e[1], e[2]) / (len2[2] + len2[1]));
+    worst = worst.min(cross(e[2], e[3]) / (len2[3] + len2[2]));
+    let q = 2.0 * worst;
+    // Verdict's floor (its DBL_MIN); false for NaN (a quad with two zero edges) too.
+    if q >= 2.220_446_049_250_313e-15 {
+        q
+    } else {
+        0.0
+    }
+}
+
 /// Verdict's shape at corner `k` of `p`: `2 α / (|a|² + |b|²)`, `α = a × b`, with
 /// `a = p_k − p_{k−1}` and `b = p_{k+1} − p_k`; the quad's shape is the least over its corners.
 #[inline]

@@ -291,7 +291,7 @@ impl Setup<'_> {
     /// every energy term, floor and gradient here agrees to the bit.
     #[inline]
     pub fn quality(&self, p: &[Point; 4]) -> (f64, f64) {
-        let shape = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
+        let shape = energy::shape(p);
         let s = match self.metric {
             Metric::Shape => shape,
             Metric::ShapeAndSize => {
@@ -658,9 +658,29 @@ mod tests {
             // Corner `flat` on the line of its neighbours, nudged across by `hair` of the scale.
             let (a, b) = (p[(flat + 3) % 4], p[(flat + 1) % 4]);
             p[flat] = Point::new(0.5 * (a.x + b.x) - hair * scale * (b.y - a.y), 0.5 * (a.y + b.y) + hair * scale * (b.x - a.x));
-            let shape = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
+            let shape = energy::shape(&p);
             if shape >= SURE_SHAPE && energy::area(&p) > 0.0 {
                 prop_assert!(is_valid(&p), "{p:?}: shape {shape}");
+            }
+        }
+
+        /// The optimiser's shape is Verdict's to the bit on every counter-clockwise quad, and
+        /// 0 where a corner turns right, the quad being convex, reflex or crossed, at any
+        /// scale and offset.
+        #[test]
+        fn the_optimisers_shape_is_verdicts(
+            corners in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 4),
+            scale in 1e-3f64..1e3, offset in -1e4f64..1e4,
+        ) {
+            let p: [Point; 4] = std::array::from_fn(|i| {
+                Point::new(offset + scale * corners[i].0, offset / 3.0 + scale * corners[i].1)
+            });
+            let verdict = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
+            let ours = energy::shape(&p);
+            if is_valid(&p) {
+                prop_assert_eq!(ours.to_bits(), verdict.to_bits(), "{:?}", p);
+            } else {
+                prop_assert!(ours < SURE_SHAPE, "{:?}: {}", p, ours);
             }
         }
 
