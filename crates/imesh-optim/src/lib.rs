@@ -291,16 +291,24 @@ impl Setup<'_> {
     /// every energy term, floor and gradient here agrees to the bit.
     #[inline]
     pub fn quality(&self, p: &[Point; 4]) -> (f64, f64) {
+        let (s, shape, _) = self.quality_and_area(p);
+        (s, shape)
+    }
+
+    /// [`Setup::quality`] and the quad's signed area.
+    #[inline]
+    fn quality_and_area(&self, p: &[Point; 4]) -> (f64, f64, f64) {
         let shape = energy::shape(p);
+        let area = energy::area(p);
         let s = match self.metric {
             Metric::Shape => shape,
             Metric::ShapeAndSize => {
-                let r = energy::area(p) / self.average_area;
+                let r = area / self.average_area;
                 let m = if r > 0.0 { r.min(1.0 / r) } else { 0.0 };
                 shape * m * m
             }
         };
-        (s, shape)
+        (s, shape, area)
     }
 
     /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
@@ -314,8 +322,8 @@ impl Setup<'_> {
     /// The metric and the shape of quad `p` when it is valid and above both floors.
     #[inline]
     fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
-        let (s, shape) = self.quality(p);
-        if !((shape >= SURE_SHAPE && energy::area(p) > 0.0) || is_valid(p)) {
+        let (s, shape, area) = self.quality_and_area(p);
+        if !((shape >= SURE_SHAPE && area > 0.0) || is_valid(p)) {
             return None;
         }
         let jacobian = self.jacobian_floors[quad];
