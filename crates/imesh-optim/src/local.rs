@@ -156,9 +156,14 @@ fn solve(
 ) -> Option<Point> {
     scratch.corners.clear();
     let mut area = 0.0;
-    for &q in variables.quads.row(i) {
+    for (&q, weights) in variables
+        .quads
+        .row(i)
+        .iter()
+        .zip(variables.corner_weights.row(i))
+    {
         let quad = setup.quads[q as usize];
-        let corners = quad.map(|v| (vertices[v as usize], variables.weight(i, v)));
+        let corners = [0, 1, 2, 3].map(|k| (vertices[quad[k] as usize], weights[k]));
         let p = corners.map(|(p, _)| p);
         area += crate::energy::area(&p);
         scratch.corners.push((q as usize, corners));

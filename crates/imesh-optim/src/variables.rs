@@ -114,6 +114,9 @@ pub(crate) struct Variables {
     pub influence: Rows<(u32, f64)>,
     /// Per variable, the quads it changes.
     pub quads: Rows<u32>,
+    /// Per variable, for each of its quads (in the order of [`Variables::quads`]), its weight
+    /// in each of the quad's corners (0 for a corner it does not move).
+    pub corner_weights: Rows<[f64; 4]>,
     /// Per variable, directed control-net edges `(a, b)` its point must stay strictly left of:
     /// the edges of its neighbour polygon, so that the point stays inside it (in its kernel).
     pub ring: Rows<[u32; 2]>,
@@ -334,12 +337,31 @@ impl Variables {
             row.sort_unstable();
             quads.push_row(row.iter().copied());
         }
+        let mut corner_weights = Rows::new();
+        for i in 0..influence.len() {
+            let weight = |v: u32| {
+                // Rows are short (a point moves at most a patch's vertices): a scan beats a
+                // search.
+                influence
+                    .row(i)
+                    .iter()
+                    .find(|&&(u, _)| u == v)
+                    .map_or(0.0, |&(_, w)| w)
+            };
+            corner_weights.push_row(
+                quads
+                    .row(i)
+                    .iter()
+                    .map(|&q| mesh.quads[q as usize].map(weight)),
+            );
+        }
         let by_quad = by_quad(&quads, mesh.quads.len());
         let colours = colour(&quads, &by_quad);
         Self {
             ids,
             influence,
             quads,
+            corner_weights,
             ring,
             colours,
             by_quad,
@@ -349,16 +371,6 @@ impl Variables {
     /// Number of variables (points; twice as many coordinates).
     pub fn len(&self) -> usize {
         self.ids.len()
-    }
-
-    /// The weight of variable `i` in vertex `v` (0 when it does not move it).
-    pub fn weight(&self, i: usize, v: u32) -> f64 {
-        // Rows are short (a point moves at most a patch's vertices): a scan beats a search.
-        self.influence
-            .row(i)
-            .iter()
-            .find(|&&(u, _)| u == v)
-            .map_or(0.0, |&(_, w)| w)
     }
 
     /// True when `p` lies strictly left of every ring edge of variable `i` (control points
