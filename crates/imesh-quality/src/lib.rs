@@ -26,11 +26,13 @@
 pub mod quad;
 pub mod tri;
 
+mod corner;
 mod stats;
 mod summary;
 mod validate;
 mod vec2;
 
+pub use corner::{sharpest_boundary_corner, BoundaryCorner};
 pub use stats::{Histogram, Statistics};
 pub use summary::{
     average_quad_area, quad_corners, quad_values, QuadQuality, QuadValues, TriangleQuality,

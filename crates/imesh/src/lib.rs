@@ -32,8 +32,8 @@ use imesh_io::SegmentedMeshData;
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 use imesh_quality::{
-    average_quad_area, quad_corners, quad_values, validate, Domain, Element, Histogram, MeshView,
-    QuadQuality, Statistics, TriangleQuality,
+    average_quad_area, quad_corners, quad_values, validate, BoundaryCorner, Domain, Element,
+    Histogram, MeshView, QuadQuality, Statistics, TriangleQuality,
 };
 use imesh_segment::{
     c_edges, merge_regions, merge_thin_regions, partition, sample, CEdge, MergeReport,
@@ -631,6 +631,11 @@ pub struct Report {
     pub fidelity: Fidelity,
     /// Quality statistics.
     pub quality: MeshQuality,
+    /// The quad corner with the smallest sine between two boundary edges (image pixels, y
+    /// down): it fills a whole sector of its region at a boundary vertex, so its sine bounds the
+    /// worst scaled Jacobian whatever the smoothing (quads only; none when no corner is held so).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sharpest_boundary_corner: Option<BoundaryCorner>,
     /// Quality statistics of the quads before optimisation (quads only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quality_before_optimisation: Option<MeshQuality>,
@@ -1139,6 +1144,7 @@ impl Pipeline {
         };
         counts.meshed_labels = mesh.used_labels().len();
         let quality = mesh_quality(&mesh, o.elements);
+        let sharpest_boundary_corner = sharpest_boundary_corner(&mesh);
         // Against the image's own labels, so that the clean-up's changes count as disagreement.
         let label_agreement = match &cleaned {
             Some(_) => agreement_with_original(&mesh, original),
@@ -1165,6 +1171,7 @@ impl Pipeline {
                 boundary_hausdorff_px: optimised.as_ref().map_or(0.0, |x| x.hausdorff),
             },
             quality,
+            sharpest_boundary_corner,
             quality_before_optimisation: optimised
                 .as_ref()
                 .map(|x| MeshQuality::Quads(x.before.clone())),
@@ -1968,6 +1975,20 @@ fn mesh_quality(mesh: &SegmentedMeshData, elements: Elements) -> MeshQuality {
         Elements::Tri => MeshQuality::Triangles(TriangleQuality::of(&mesh.vertices, &triangles)),
         Elements::Quad => MeshQuality::Quads(QuadQuality::of(&mesh.vertices, &quads)),
     }
+}
+
+/// [`imesh_quality::sharpest_boundary_corner`] of `mesh`'s quads (`None` for a mesh with a
+/// triangle).
+fn sharpest_boundary_corner(mesh: &SegmentedMeshData) -> Option<BoundaryCorner> {
+    let quads: Vec<[u32; 4]> = mesh
+        .elements
+        .iter()
+        .map(|e| match *e {
+            Element::Quad(q) => Some(q),
+            Element::Triangle(_) => None,
+        })
+        .collect::<Option<_>>()?;
+    imesh_quality::sharpest_boundary_corner(&mesh.vertices, &quads, &mesh.labels)
 }
 
 /// [`label_agreement`] of a mesh whose labels name the regions of another grid (a cleaned or

@@ -614,6 +614,15 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             );
         }
         println!("{line}");
+        // A worst corner the boundaries force: say so, and where (the image's own corner).
+        if let Some(corner) = report.sharpest_boundary_corner {
+            if q.scaled_jacobian().min >= corner.scaled_jacobian - 1e-9 {
+                println!(
+                    "the worst scaled Jacobian is the image's own corner: {:.1}° between two boundaries at ({:.1}, {:.1}) px, which the quad there must keep",
+                    corner.angle_deg, corner.at[0], corner.at[1]
+                );
+            }
+        }
         if c.reduction > 1 {
             println!(
                 "meshed on a {}×{} grid of cells of about {f}×{f} px (--reduction 1 meshes every pixel)",
