@@ -10,8 +10,9 @@
 //! orientation), every moved control point stays strictly inside the polygon of its
 //! neighbours in the control net, no quad falls below the mesh's starting worst quality, and
 //! no quad's shape falls below its own start shape or [`OptimOptions::keep_shape`], whichever
-//! is lower: the result is never worse than the start, and sizes are evened out (shape-and-size)
-//! only where shapes allow.
+//! is lower (the last repair may take a quad to [`REPAIR_FLOOR`] for a worse neighbour): the
+//! result is never worse than the start, and sizes are evened out (shape-and-size) only where
+//! shapes allow.
 //!
 //! [`Method`]s: [`Method::Local`] (default) is block coordinate descent, one control point at a
 //! time by [`Powell`]'s method, points coloured so that one colour shares no quad and is solved
@@ -142,7 +143,9 @@ pub struct OptimOptions {
     pub global_iterations: u64,
     /// No quad whose shape is at least this may fall below it, and no other quad below its
     /// start shape: with shape-and-size, sizes are evened out only where shapes allow. 0 leaves
-    /// only the global guard (no quad below the start's worst shape).
+    /// only the global guard (no quad below the start's worst shape). The repair
+    /// ([`OptimOptions::repair`]) may still lower a quad to [`REPAIR_FLOOR`] for a worse
+    /// neighbour.
     pub keep_shape: f64,
     /// No quad whose quality (the metric's) is at least this at the start may fall below it
     /// in the descent and the sliding: good quads are not spent on their neighbours
