@@ -36,8 +36,8 @@ pub fn sharpest_boundary_corner(
     quads: &[[u32; 4]],
     labels: &[u32],
 ) -> Option<BoundaryCorner> {
-    // Every quad side as (smaller end, larger end, label), sorted: a side is interior when the
-    // next entry is the same edge with the same label.
+    // Every quad side as (smaller end, larger end, label), sorted so that an edge's sides are
+    // neighbours: it is a boundary edge when it has one, or two of different labels.
     let mut sides: Vec<(u32, u32, u32)> = quads
         .iter()
         .zip(labels)
@@ -49,21 +49,11 @@ pub fn sharpest_boundary_corner(
         })
         .collect();
     sides.sort_unstable();
-    let mut boundary = std::collections::HashSet::new();
-    let mut i = 0;
-    while i < sides.len() {
-        let (a, b, label) = sides[i];
-        let mut j = i + 1;
-        let mut mixed = false;
-        while j < sides.len() && (sides[j].0, sides[j].1) == (a, b) {
-            mixed |= sides[j].2 != label;
-            j += 1;
-        }
-        if j - i == 1 || mixed {
-            boundary.insert((a, b));
-        }
-        i = j;
-    }
+    let boundary: std::collections::HashSet<(u32, u32)> = sides
+        .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
+        .filter(|edge| edge.len() == 1 || edge.iter().any(|s| s.2 != edge[0].2))
+        .map(|edge| (edge[0].0, edge[0].1))
+        .collect();
     let on_boundary = |a: u32, b: u32| boundary.contains(&(a.min(b), a.max(b)));
     let mut sharpest: Option<BoundaryCorner> = None;
     for q in quads {

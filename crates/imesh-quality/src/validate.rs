@@ -331,27 +331,21 @@ fn check_edges(
     report: &mut ValidationReport,
 ) {
     edges.sort_unstable();
-    let mut i = 0;
-    while i < edges.len() {
-        let (a, b, _) = edges[i];
-        let mut j = i;
-        while j < edges.len() && edges[j].0 == a && edges[j].1 == b {
-            j += 1;
-        }
-        match j - i {
+    for edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let (a, b, _) = edge[0];
+        match edge.len() {
             1 => {
                 if !domain.on_border(mesh.vertices[a as usize], mesh.vertices[b as usize]) {
                     report.push(Violation::OpenEdgeInside { a, b });
                 }
             }
             2 => {
-                if edges[i].2 == edges[i + 1].2 {
+                if edge[0].2 == edge[1].2 {
                     report.push(Violation::EdgeSameDirection { a, b });
                 }
             }
             count => report.push(Violation::EdgeSharedTooOften { a, b, count }),
         }
-        i = j;
     }
 }
 
