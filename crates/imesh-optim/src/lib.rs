@@ -535,7 +535,8 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         // The repair trades a quad's size for the corners of its neighbours: of the metric it
         // keeps only the start's worst (held to each quad's own, it left grass's worst shape
         // 0.136 → 0.106 and stardist's 0.312 → 0.302); a quad's shape and scaled Jacobian may
-        // fall to REPAIR_FLOOR, never below where they are now, so the worst of neither falls.
+        // fall to REPAIR_FLOOR (a quad already under it stays where it is or above), never
+        // below the start's worst, so the worst of neither falls.
         let loose = vec![worst; quads.len()];
         let (shape_now, jacobian_now): (Vec<f64>, Vec<f64>) = quads
             .par_iter()
