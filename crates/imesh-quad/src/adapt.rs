@@ -2,7 +2,8 @@
 //! (DESIGN.md §2, step 9; the paper's section V-C).
 
 use imesh_curves::{CubicBezier, CurveGraph};
-use imesh_geom::Point;
+use imesh_geom::{Point, VertexId};
+use rayon::prelude::*;
 
 use crate::dt::{RegionTriangulation, NONE};
 use crate::mesh::QuadMesh;
@@ -97,49 +98,52 @@ pub fn adapt(
     // The G' edge a Steiner vertex lies on: its move onto the curve affects every element
     // around it, not only those with a side on the curve.
     let mut curve_of_vertex = vec![NONE; t.num_vertices()];
-    for (e, &h) in m.edges.iter().enumerate() {
-        let Some((k, _)) = dt.graph_edge(g, h) else {
-            continue;
-        };
-        let Some(&curve) = curves.get(k as usize) else {
-            continue;
-        };
-        let (u0, u1) = (
-            parameter[t.origin(h).index()],
-            parameter[t.destination(h).index()],
-        );
-        let (u0, u1) = if dt.graph_vertex[t.origin(h).index()] != NONE
-            || dt.graph_vertex[t.destination(h).index()] != NONE
-        {
-            // A G' vertex: its parameter is 0 or 1 according to the end it is.
-            let ends = g.edges()[k as usize].ends;
-            let at = |v: imesh_geom::VertexId, u: f64| match dt.graph_vertex[v.index()] {
-                x if x == ends[0] => 0.0,
-                x if x == ends[1] => 1.0,
-                _ => u,
+    let found: Vec<EdgeCurve> = m
+        .edges
+        .par_iter()
+        .enumerate()
+        .filter_map(|(e, &h)| {
+            let (k, _) = dt.graph_edge(g, h)?;
+            let curve = curves.get(k as usize)?;
+            let (u0, u1) = (
+                parameter[t.origin(h).index()],
+                parameter[t.destination(h).index()],
+            );
+            let (u0, u1) = if dt.graph_vertex[t.origin(h).index()] != NONE
+                || dt.graph_vertex[t.destination(h).index()] != NONE
+            {
+                // A G' vertex: its parameter is 0 or 1 according to the end it is.
+                let ends = g.edges()[k as usize].ends;
+                let at = |v: VertexId, u: f64| match dt.graph_vertex[v.index()] {
+                    x if x == ends[0] => 0.0,
+                    x if x == ends[1] => 1.0,
+                    _ => u,
+                };
+                (at(t.origin(h), u0), at(t.destination(h), u1))
+            } else {
+                (u0, u1)
             };
-            (at(t.origin(h), u0), at(t.destination(h), u1))
-        } else {
-            (u0, u1)
-        };
-        if u0 == u1 {
-            continue;
-        }
+            (u0 != u1).then(|| EdgeCurve {
+                edge: e as u32,
+                graph_edge: k,
+                parameters: [u0, u1],
+                curve: piece_of(curve, u0, u1),
+                chord: [t.point(t.origin(h)), t.point(t.destination(h))],
+                weight: 1.0,
+            })
+        })
+        .collect();
+    for ec in found {
+        let (e, k) = (ec.edge as usize, ec.graph_edge);
         curve_of_edge[e] = adapted.len() as u32;
         pieces[k as usize].push(adapted.len() as u32);
+        let h = m.edges[e];
         for v in [t.origin(h), t.destination(h)] {
             if dt.graph_vertex[v.index()] == NONE {
                 curve_of_vertex[v.index()] = k;
             }
         }
-        adapted.push(EdgeCurve {
-            edge: e as u32,
-            graph_edge: k,
-            parameters: [u0, u1],
-            curve: piece_of(&curve, u0, u1),
-            chord: [t.point(t.origin(h)), t.point(t.destination(h))],
-            weight: 1.0,
-        });
+        adapted.push(ec);
     }
     for ec in &adapted {
         place(dt, m, net, ec);
@@ -148,6 +152,7 @@ pub fn adapt(
     // Only the elements with a moved corner or a curved side change; their quads' straight
     // scaled Jacobians are the bar adaptation must not push them under.
     let touched: Vec<usize> = (0..m.elements.len())
+        .into_par_iter()
         .filter(|&index| {
             let moved = m.elements[index]
                 .corners()
@@ -159,24 +164,62 @@ pub fn adapt(
         })
         .collect();
     let mut bar = vec![f64::NEG_INFINITY; q.quads.len()];
-    for &index in &touched {
-        for x in q.element_quads(index) {
-            bar[x] = POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9;
-        }
+    let bars: Vec<(usize, f64)> = touched
+        .par_iter()
+        .flat_map_iter(|&index| {
+            let q = &*q;
+            q.element_quads(index)
+                .map(move |x| (x, POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9))
+        })
+        .collect();
+    for (x, b) in bars {
+        bar[x] = b;
     }
-    // Per call of `evaluate`, which M edges it has evaluated.
+    // Per round, which M edges it has evaluated.
     let mut edge_stamp = vec![0u32; m.edges.len()];
+    let mut edges = Vec::new();
     let mut stamp = 1;
     evaluate(q, m, net, &touched, &mut edge_stamp, stamp);
-    let needs_repair =
-        |q: &QuadMesh, index: usize| q.element_quads(index).any(|x| !q.is_valid_above(x, bar[x]));
-    let mut bad: Vec<usize> = touched
-        .into_iter()
-        .filter(|&i| needs_repair(q, i))
-        .collect();
+    let needs_repair = |q: &QuadMesh, elements: &[usize]| -> Vec<usize> {
+        elements
+            .par_iter()
+            .copied()
+            .filter(|&index| q.element_quads(index).any(|x| !q.is_valid_above(x, bar[x])))
+            .collect()
+    };
+    let mut bad = needs_repair(q, &touched);
     // Per-round stamps: a G' edge is damped at most once a round, an element listed once.
     let mut curve_round = vec![0u32; g.edges().len()];
     let mut element_round = vec![0u32; m.elements.len()];
+    // The elements a G' edge's damping moves: those on both sides of its pieces, and all
+    // around their (Steiner) ends.
+    let moved_by: Vec<Vec<u32>> = pieces
+        .par_iter()
+        .map(|pieces| {
+            let mut elements = Vec::new();
+            for &p in pieces {
+                let h = m.edges[adapted[p as usize].edge as usize];
+                let around = |v: VertexId| {
+                    (dt.graph_vertex[v.index()] == NONE)
+                        .then(|| t.vertex_triangles(v))
+                        .into_iter()
+                        .flatten()
+                };
+                let sides = [t.triangle_of(h), t.triangle_of(t.twin(h))];
+                elements.extend(
+                    sides
+                        .into_iter()
+                        .chain(around(t.origin(h)))
+                        .chain(around(t.destination(h)))
+                        .filter_map(|f| m.element_of_triangle.get(f.index()).copied())
+                        .filter(|&el| el != NONE),
+                );
+            }
+            elements.sort_unstable();
+            elements.dedup();
+            elements
+        })
+        .collect();
     let mut relaxed = vec![false; m.elements.len()];
     let mut damped = vec![false; g.edges().len()];
     let mut weight = vec![1.0f64; g.edges().len()];
@@ -185,22 +228,18 @@ pub fn adapt(
             break;
         }
         // The round's elements: the first round's bad ones were evaluated above; later rounds'
-        // had a side or a corner moved by a damped curve.
+        // had a side or a corner moved by a damped curve, and their inner points follow from
+        // the relaxation below.
         if round > 1 {
             stamp += 1;
-            evaluate(q, m, net, &bad, &mut edge_stamp, stamp);
+            sides(m, &bad, &mut edge_stamp, stamp, &mut edges);
+            q.evaluate_edges(net, &mut edges);
         }
+        q.relax_insides(m, net, &bad);
         for &index in &bad {
-            net.relax_inner(&m.elements[index], index);
-            q.evaluate_inside(m, net, index);
             relaxed[index] = true;
         }
-        let still: Vec<usize> = bad
-            .iter()
-            .copied()
-            .filter(|&i| needs_repair(q, i))
-            .collect();
-        for index in still {
+        for index in needs_repair(q, &bad) {
             let element = &m.elements[index];
             let sides = (0..m.side_count(index)).filter_map(|side| {
                 let c = curve_of_edge[m.side_edge(index, side).0 as usize];
@@ -233,26 +272,9 @@ pub fn adapt(
                     let ec = &mut adapted[p as usize];
                     ec.weight = weight[k];
                     place(dt, m, net, ec);
-                    let h = m.edges[ec.edge as usize];
-                    // The elements on both sides, and all around its moved (Steiner) corners.
-                    let around = |v: imesh_geom::VertexId| {
-                        (dt.graph_vertex[v.index()] == NONE)
-                            .then(|| t.vertex_triangles(v))
-                            .into_iter()
-                            .flatten()
-                    };
-                    let sides = [t.triangle_of(h), t.triangle_of(t.twin(h))];
-                    for f in sides
-                        .into_iter()
-                        .chain(around(t.origin(h)))
-                        .chain(around(t.destination(h)))
-                    {
-                        if let Some(&el) = m.element_of_triangle.get(f.index()) {
-                            if el != NONE {
-                                element_round[el as usize] = round;
-                            }
-                        }
-                    }
+                }
+                for &el in &moved_by[k] {
+                    element_round[el as usize] = round;
                 }
             }
         }
@@ -266,7 +288,13 @@ pub fn adapt(
     evaluate(q, m, net, &bad, &mut edge_stamp, stamp + 1);
     report.relaxed_patches = relaxed.iter().filter(|&&r| r).count();
     report.damped_curves = damped.iter().filter(|&&d| d).count();
-    report.invalid_left = (0..q.quads.len()).filter(|&x| !q.is_valid(x)).count();
+    // Only the touched elements' quads moved: the rest are straight templates of strictly
+    // convex elements, valid as built.
+    report.invalid_left = touched
+        .par_iter()
+        .flat_map_iter(|&index| q.element_quads(index))
+        .filter(|&x| !q.is_valid(x))
+        .count();
     (report, adapted)
 }
 
@@ -280,14 +308,29 @@ fn evaluate(
     edge_stamp: &mut [u32],
     stamp: u32,
 ) {
+    let mut edges = Vec::new();
+    sides(m, elements, edge_stamp, stamp, &mut edges);
+    q.evaluate_edges(net, &mut edges);
+    q.evaluate_insides(m, net, elements);
+}
+
+/// The M edges on the sides of `elements`, each once (marked with `stamp` in `edge_stamp`),
+/// into `edges`.
+fn sides(
+    m: &ElementMesh,
+    elements: &[usize],
+    edge_stamp: &mut [u32],
+    stamp: u32,
+    edges: &mut Vec<u32>,
+) {
+    edges.clear();
     for &index in elements {
         for side in 0..m.side_count(index) {
             let e = m.side_edge(index, side).0;
             if std::mem::replace(&mut edge_stamp[e as usize], stamp) != stamp {
-                q.evaluate_edge(net, e);
+                edges.push(e);
             }
         }
-        q.evaluate_inside(m, net, index);
     }
 }
 
@@ -298,39 +341,46 @@ fn evaluate(
 /// that edge keeps the straight parameters.
 fn curve_parameters(dt: &RegionTriangulation, g: &CurveGraph, curves: &[CubicBezier]) -> Vec<f64> {
     let t = &dt.triangulation;
+    // Per segment, its vertices and their parameters; a G' vertex ends several segments, and
+    // takes the last one's (adaptation reads a G' vertex's parameter from its end, not here).
+    let per_segment: Vec<Vec<(VertexId, f64)>> = (0..t.num_segments())
+        .into_par_iter()
+        .map(|s| {
+            let Some(&k) = dt.segment_edge.get(s) else {
+                return Vec::new();
+            };
+            let Some(curve) = curves.get(k as usize) else {
+                return Vec::new();
+            };
+            let chain = dt.segment_pieces(imesh_geom::SegmentId(s as u32));
+            let straight: Vec<f64> = chain.iter().map(|&v| dt.edge_parameter(g, k, v)).collect();
+            let n = chain.len();
+            // The ends are the curve's ends, whichever way the segment was inserted; only the
+            // Steiner vertices between them are projected.
+            let projected: Vec<f64> = chain
+                .iter()
+                .zip(&straight)
+                .enumerate()
+                .map(|(i, (&v, &u))| {
+                    if i == 0 || i + 1 == n {
+                        u.round()
+                    } else {
+                        curve.closest_parameter(t.point(v), u)
+                    }
+                })
+                .collect();
+            let increasing = straight.first() <= straight.last();
+            let ordered =
+                projected
+                    .windows(2)
+                    .all(|w| if increasing { w[0] < w[1] } else { w[0] > w[1] });
+            let chosen = if ordered { projected } else { straight };
+            chain.into_iter().zip(chosen).collect()
+        })
+        .collect();
     let mut parameter = vec![0.0; t.num_vertices()];
-    for s in 0..t.num_segments() {
-        let Some(&k) = dt.segment_edge.get(s) else {
-            continue;
-        };
-        let Some(curve) = curves.get(k as usize) else {
-            continue;
-        };
-        let chain = dt.segment_pieces(imesh_geom::SegmentId(s as u32));
-        let straight: Vec<f64> = chain.iter().map(|&v| dt.edge_parameter(g, k, v)).collect();
-        let n = chain.len();
-        // The ends are the curve's ends, whichever way the segment was inserted; only the
-        // Steiner vertices between them are projected.
-        let projected: Vec<f64> = chain
-            .iter()
-            .zip(&straight)
-            .enumerate()
-            .map(|(i, (&v, &u))| {
-                if i == 0 || i + 1 == n {
-                    u.round()
-                } else {
-                    curve.closest_parameter(t.point(v), u)
-                }
-            })
-            .collect();
-        let increasing = straight.first() <= straight.last();
-        let ordered = projected
-            .windows(2)
-            .all(|w| if increasing { w[0] < w[1] } else { w[0] > w[1] });
-        let chosen = if ordered { &projected } else { &straight };
-        for (&v, &u) in chain.iter().zip(chosen) {
-            parameter[v.index()] = u;
-        }
+    for (v, u) in per_segment.into_iter().flatten() {
+        parameter[v.index()] = u;
     }
     parameter
 }

@@ -5,8 +5,9 @@ use imesh_geom::predicates::orient2d;
 use imesh_geom::{Point, Triangulation};
 
 use crate::pairing::{Element, ElementMesh};
-use crate::patch::ControlNet;
+use crate::patch::{eval_patch_terms, relaxed_inner, ControlNet};
 use crate::template::{Place, Template};
+use rayon::prelude::*;
 
 /// An element of M that holds a vertex of Q, and the vertex's canonical coordinates there.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +37,9 @@ pub struct QuadMesh {
     points: Vec<u32>,
     /// Per element, its first quad (its quads are contiguous).
     quad_first: Vec<u32>,
+    /// Per element, its first inner vertex (its inner vertices are consecutive, in the order
+    /// of their [`Place::Inside`] numbers), and the end.
+    inside_first: Vec<u32>,
     /// DT' vertices (the first vertices of Q).
     corner_count: u32,
     /// The triangle and the quad template.
@@ -73,6 +77,7 @@ impl QuadMesh {
         let mut quad_first = Vec::with_capacity(m.elements.len() + 1);
         quad_first.push(0u32);
         let mut next_inside = inside_base;
+        let mut inside_first = Vec::with_capacity(m.elements.len() + 1);
         for (index, element) in m.elements.iter().enumerate() {
             let tp = template(element);
             let corners = element.corners();
@@ -89,6 +94,7 @@ impl QuadMesh {
                 };
                 points.push(id);
             }
+            inside_first.push(next_inside);
             next_inside += tp.inside;
             point_first.push(points.len() as u32);
             for q in &tp.quads {
@@ -98,6 +104,7 @@ impl QuadMesh {
             }
             quad_first.push(quads.len() as u32);
         }
+        inside_first.push(next_inside);
         let n = next_inside as usize;
         // Holders, compressed by vertex.
         let mut holder_first = vec![0u32; n + 1];
@@ -136,6 +143,7 @@ impl QuadMesh {
             point_first,
             points,
             quad_first,
+            inside_first,
             corner_count: nv,
             level: k,
             along_edge: (1..2 * k)
@@ -155,12 +163,10 @@ impl QuadMesh {
             }),
             templates: Box::new(templates),
         };
-        for e in 0..m.edges.len() as u32 {
-            mesh.evaluate_edge(net, e);
-        }
-        for index in 0..m.elements.len() {
-            mesh.evaluate_inside(m, net, index);
-        }
+        let mut edges: Vec<u32> = (0..m.edges.len() as u32).collect();
+        mesh.evaluate_edges(net, &mut edges);
+        let elements: Vec<usize> = (0..m.elements.len()).collect();
+        mesh.evaluate_insides(m, net, &elements);
         mesh
     }
 
@@ -255,45 +261,120 @@ impl QuadMesh {
     /// which is every patch that has the edge restricted to it. A vertex shared by two
     /// elements thus has the same bits whichever of them is evaluated, and last.
     pub fn evaluate_edge(&mut self, net: &ControlNet, e: u32) {
-        let [a, b] = self.edge_ends[e as usize].map(|v| v as usize);
-        let [i, j] = net.edge_inner(e).map(|c| c as usize);
-        let control = [net.points[a], net.points[i], net.points[j], net.points[b]];
-        self.vertices[a] = control[0];
-        self.vertices[b] = control[3];
-        // Exact on axis-parallel straight edges (the domain border, pixel-aligned boundaries),
-        // whatever the rounding of the sum.
-        let same_x = control.iter().all(|p| p.x == control[0].x);
-        let same_y = control.iter().all(|p| p.y == control[0].y);
-        let per_edge = 2 * self.level - 1;
-        let base = (self.corner_count + per_edge * e) as usize;
-        for (v, w) in self.vertices[base..base + per_edge as usize]
-            .iter_mut()
-            .zip(&self.along_edge)
-        {
-            let (mut x, mut y) = (0.0, 0.0);
-            for (w, p) in w.iter().zip(&control) {
-                x += w * p.x;
-                y += w * p.y;
+        let ends = self.edge_ends[e as usize];
+        for v in ends {
+            self.vertices[v as usize] = net.points[v as usize];
+        }
+        let per_edge = (2 * self.level - 1) as usize;
+        let first = self.corner_count as usize + per_edge * e as usize;
+        along_edge(
+            &self.along_edge,
+            edge_control(net, e, ends),
+            &mut self.vertices[first..first + per_edge],
+        );
+    }
+
+    /// [`QuadMesh::evaluate_edge`] for each of `edges` (distinct; sorted here), in parallel:
+    /// each edge's template points are its own slice of the vertices.
+    pub(crate) fn evaluate_edges(&mut self, net: &ControlNet, edges: &mut [u32]) {
+        edges.sort_unstable();
+        let per_edge = (2 * self.level - 1) as usize;
+        let (corners, rest) = self.vertices.split_at_mut(self.corner_count as usize);
+        let slices = disjoint_slices(
+            rest,
+            edges.iter().map(|&e| (per_edge * e as usize, per_edge)),
+        );
+        let (along, ends) = (&self.along_edge, &self.edge_ends);
+        edges
+            .par_iter()
+            .zip(slices)
+            .for_each(|(&e, out)| along_edge(along, edge_control(net, e, ends[e as usize]), out));
+        for &e in edges.iter() {
+            for v in ends[e as usize] {
+                corners[v as usize] = net.points[v as usize];
             }
-            if same_x {
-                x = control[0].x;
-            }
-            if same_y {
-                y = control[0].y;
-            }
-            *v = Point::new(x, y);
         }
     }
 
     /// Re-evaluates the inner template points of element `index` (those on no side) from its
     /// patch: all that changes when only its inner control points move.
     pub fn evaluate_inside(&mut self, m: &ElementMesh, net: &ControlNet, index: usize) {
-        let kind = usize::from(matches!(m.elements[index], Element::Quad(_)));
+        let range = self.inside_range(index);
         let ids = &self.points[self.point_first[index] as usize..];
-        let terms = &self.templates[kind].terms;
-        for &i in &self.inside_places[kind] {
-            self.vertices[ids[i as usize] as usize] = net.eval_terms(index, &terms[i as usize]);
-        }
+        let kind = usize::from(matches!(m.elements[index], Element::Quad(_)));
+        inside_points(
+            &self.templates[kind],
+            &self.inside_places[kind],
+            ids,
+            range.start as u32,
+            &net.patch_points(index),
+            &mut self.vertices[range],
+        );
+    }
+
+    /// The inner vertices of element `index` (consecutive).
+    fn inside_range(&self, index: usize) -> std::ops::Range<usize> {
+        self.inside_first[index] as usize..self.inside_first[index + 1] as usize
+    }
+
+    /// [`QuadMesh::evaluate_inside`] for each of `elements` (increasing), in parallel: each
+    /// element's inner vertices are consecutive and its own.
+    pub(crate) fn evaluate_insides(
+        &mut self,
+        m: &ElementMesh,
+        net: &ControlNet,
+        elements: &[usize],
+    ) {
+        let (this, slices) = InsideView::split(self, elements);
+        elements.par_iter().zip(slices).for_each(|(&k, out)| {
+            this.evaluate(m, k, &net.patch_points(k), out);
+        });
+    }
+
+    /// [`ControlNet::relax_inner`] then [`QuadMesh::evaluate_inside`] for each of `elements`
+    /// (increasing), in parallel: each element's inner control points and inner vertices are
+    /// consecutive and its own.
+    pub(crate) fn relax_insides(
+        &mut self,
+        m: &ElementMesh,
+        net: &mut ControlNet,
+        elements: &[usize],
+    ) {
+        let (this, slices) = InsideView::split(self, elements);
+        let (boundary, inner, patches) = net.split_inner();
+        let first_inner = boundary.len();
+        let controls = disjoint_slices(
+            inner,
+            elements.iter().map(|&k| {
+                let count = if matches!(m.elements[k], Element::Quad(_)) {
+                    4
+                } else {
+                    1
+                };
+                (patches[k][5] as usize - first_inner, count)
+            }),
+        );
+        elements
+            .par_iter()
+            .zip(controls.into_par_iter().zip(slices))
+            .for_each(|(&k, (control, out))| {
+                // The patch's boundary control points, and its own inner ones.
+                let mut patch = patches[k].map(|c| {
+                    if c == u32::MAX {
+                        Point::new(0.0, 0.0) // a triangle's unused slot
+                    } else if (c as usize) < first_inner {
+                        boundary[c as usize]
+                    } else {
+                        control[(c - patches[k][5]) as usize]
+                    }
+                });
+                let (relaxed, count) = relaxed_inner(&m.elements[k], &patch);
+                for &(slot, p) in &relaxed[..count] {
+                    patch[slot] = p;
+                    control[(patches[k][slot] - patches[k][5]) as usize] = p;
+                }
+                this.evaluate(m, k, &patch, out);
+            });
     }
 
     /// True when quad `q` has a positive Jacobian at all four corners (exact orientation).
@@ -351,6 +432,124 @@ impl QuadMesh {
     }
 }
 
+/// What evaluating an element's inner points reads of a [`QuadMesh`], borrowed apart from its
+/// vertices (which the evaluation writes).
+#[derive(Clone, Copy)]
+struct InsideView<'a> {
+    templates: &'a [Template; 2],
+    places: &'a [Vec<u32>; 2],
+    points: &'a [u32],
+    point_first: &'a [u32],
+    inside_first: &'a [u32],
+}
+
+impl<'a> InsideView<'a> {
+    /// The view of `q`, and the slices of `q`'s inner vertices of `elements` (increasing).
+    fn split(q: &'a mut QuadMesh, elements: &[usize]) -> (Self, Vec<&'a mut [Point]>) {
+        let first = q.corner_count as usize + (2 * q.level as usize - 1) * q.edge_ends.len();
+        let (_, inner) = q.vertices.split_at_mut(first);
+        let inside_first = &q.inside_first;
+        let slices = disjoint_slices(
+            inner,
+            elements.iter().map(|&k| {
+                let start = inside_first[k] as usize;
+                (start - first, inside_first[k + 1] as usize - start)
+            }),
+        );
+        let view = Self {
+            templates: &q.templates,
+            places: &q.inside_places,
+            points: &q.points,
+            point_first: &q.point_first,
+            inside_first,
+        };
+        (view, slices)
+    }
+
+    /// Element `k`'s inner points from its control points `patch`, into `out` (its inner
+    /// vertices).
+    fn evaluate(&self, m: &ElementMesh, k: usize, patch: &[Point; 16], out: &mut [Point]) {
+        let kind = usize::from(matches!(m.elements[k], Element::Quad(_)));
+        inside_points(
+            &self.templates[kind],
+            &self.places[kind],
+            &self.points[self.point_first[k] as usize..],
+            self.inside_first[k],
+            patch,
+            out,
+        );
+    }
+}
+
+/// The four control points of M edge `e` with ends `ends`, from its origin.
+fn edge_control(net: &ControlNet, e: u32, ends: [u32; 2]) -> [Point; 4] {
+    let [i, j] = net.edge_inner(e).map(|c| c as usize);
+    [
+        net.points[ends[0] as usize],
+        net.points[i],
+        net.points[j],
+        net.points[ends[1] as usize],
+    ]
+}
+
+/// The template points along an edge with Bézier `control`, at the Bernstein weights `along`,
+/// into `out`.
+fn along_edge(along: &[[f64; 4]], control: [Point; 4], out: &mut [Point]) {
+    // Exact on axis-parallel straight edges (the domain border, pixel-aligned boundaries),
+    // whatever the rounding of the sum.
+    let same_x = control.iter().all(|p| p.x == control[0].x);
+    let same_y = control.iter().all(|p| p.y == control[0].y);
+    for (v, w) in out.iter_mut().zip(along) {
+        let (mut x, mut y) = (0.0, 0.0);
+        for (w, p) in w.iter().zip(&control) {
+            x += w * p.x;
+            y += w * p.y;
+        }
+        if same_x {
+            x = control[0].x;
+        }
+        if same_y {
+            y = control[0].y;
+        }
+        *v = Point::new(x, y);
+    }
+}
+
+/// The inner points of an element of template `template` (inner places `places`, vertex ids
+/// `ids` by template point, the first inner one `first`) from its control points `patch`,
+/// into `out` (its inner vertices, consecutive from `first`).
+fn inside_points(
+    template: &Template,
+    places: &[u32],
+    ids: &[u32],
+    first: u32,
+    patch: &[Point; 16],
+    out: &mut [Point],
+) {
+    for &i in places {
+        out[(ids[i as usize] - first) as usize] =
+            eval_patch_terms(patch, &template.terms[i as usize]);
+    }
+}
+
+/// The slices `[start, start + len)` of `data`, for ranges in increasing order that do not
+/// overlap: each can be written by its own worker.
+fn disjoint_slices<T>(
+    mut data: &mut [T],
+    ranges: impl Iterator<Item = (usize, usize)>,
+) -> Vec<&mut [T]> {
+    let mut out = Vec::new();
+    let mut offset = 0;
+    for (start, len) in ranges {
+        let (_, rest) = std::mem::take(&mut data).split_at_mut(start - offset);
+        let (slice, rest) = rest.split_at_mut(len);
+        out.push(slice);
+        data = rest;
+        offset = start + len;
+    }
+    out
+}
+
 /// A quad whose scaled Jacobian (as computed) is at least this is valid without the exact
 /// test: at every corner the computed cross product `a × b` is then at least `10⁻¹⁰ |a| |b|`,
 /// some 10⁵ times the bound on its rounding error (a few ε times `|aₓ b_y| + |a_y bₓ|`, itself at
@@ -372,4 +571,78 @@ pub(crate) fn scaled_jacobian(p: &[Point; 4]) -> f64 {
             }
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Pairing;
+    use proptest::prelude::*;
+
+    /// A pairing of a jittered grid, its straight net with every control point moved by up to
+    /// `shift` (from `moves`), and its level-`k` templates evaluated from the straight net.
+    fn moved(
+        k: u32,
+        moves: &[(f64, f64)],
+        shift: f64,
+    ) -> (Triangulation, ElementMesh, ControlNet, QuadMesh) {
+        let points: Vec<Point> = (0..36u32)
+            .map(|i| {
+                let (dx, dy) = moves[i as usize % moves.len()];
+                Point::new(f64::from(i % 6) + 0.3 * dx, f64::from(i / 6) + 0.3 * dy)
+            })
+            .collect();
+        let (t, _) = Triangulation::from_points(&points).expect("a jittered grid triangulates");
+        let m = ElementMesh::pair(&t, Pairing::Greedy);
+        let mut net = ControlNet::straight(&t, &m);
+        let q = QuadMesh::build(&t, &m, &net, k);
+        for (p, &(dx, dy)) in net.points.iter_mut().zip(moves.iter().cycle()) {
+            *p = Point::new(p.x + shift * dx, p.y + shift * dy);
+        }
+        (t, m, net, q)
+    }
+
+    proptest! {
+        /// The parallel passes write the same bits as the one-at-a-time evaluation, for any
+        /// subset of edges (in any order) and of elements.
+        #[test]
+        fn parallel_passes_match_one_at_a_time(
+            k in 1u32..4,
+            moves in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 7..40),
+            pick in 1usize..4,
+        ) {
+            let (_, m, net, q) = moved(k, &moves, 0.05);
+            // A subset of the edges, in decreasing order; every element but one in `pick`.
+            let mut edges: Vec<u32> = (0..m.edges.len() as u32)
+                .rev()
+                .filter(|e| *e as usize % pick == 0)
+                .collect();
+            let elements: Vec<usize> = (0..m.elements.len()).filter(|e| e % pick != 1).collect();
+
+            let (mut one_net, mut one) = (net.clone(), q.clone());
+            for &e in &edges {
+                one.evaluate_edge(&one_net, e);
+            }
+            for &index in &elements {
+                one_net.relax_inner(&m.elements[index], index);
+                one.evaluate_inside(&m, &one_net, index);
+            }
+            let (mut all_net, mut all) = (net.clone(), q.clone());
+            all.evaluate_edges(&all_net, &mut edges);
+            all.relax_insides(&m, &mut all_net, &elements);
+            prop_assert_eq!(&one.vertices, &all.vertices);
+            prop_assert_eq!(&one_net.points, &all_net.points);
+
+            // Without relaxing: the inner points from the net as it is.
+            let straight = q.clone();
+            let (mut one, mut all) = (q.clone(), q);
+            for &index in &elements {
+                one.evaluate_inside(&m, &net, index);
+            }
+            all.evaluate_insides(&m, &net, &elements);
+            prop_assert_eq!(&one.vertices, &all.vertices);
+            // The net moved, so the passes had something to change.
+            prop_assert!(all.vertices != straight.vertices);
+        }
+    }
 }

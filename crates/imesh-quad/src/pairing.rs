@@ -5,6 +5,7 @@ use imesh_geom::{HalfEdgeId, Point, TriangleId, Triangulation};
 
 use crate::dt::NONE;
 use crate::mesh::scaled_jacobian;
+use rayon::prelude::*;
 
 /// How triangles are paired.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -199,13 +200,29 @@ fn strictly_convex(q: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(q[(i + 3) % 4], q[i], q[(i + 1) % 4]) > 0.0)
 }
 
-/// Sorts `(key, half-edge)` pairs by decreasing key, then increasing half-edge: the order of
+/// The half-edges of `candidates` by decreasing key, then increasing half-edge: the order of
 /// the paper's max-heap, made deterministic. The keys are lengths and corner sines, never
-/// negative, so their bits sort as they do, and the pairs are all distinct: an unstable sort
-/// on integers gives the one order, without a comparator's branches.
-fn sort_best_first(candidates: &mut [(f64, HalfEdgeId)]) {
-    debug_assert!(candidates.iter().all(|&(key, _)| key >= 0.0));
-    candidates.sort_unstable_by_key(|&(key, h)| (std::cmp::Reverse(key.to_bits()), h.index()));
+/// negative, so their bits sort as they do, and the pairs are all distinct: one integer per
+/// pair, the key's bits inverted above the half-edge's index, sorts into the one order
+/// without a comparator's branches.
+fn best_first(
+    t: &Triangulation,
+    key: impl Fn(HalfEdgeId) -> Option<f64> + Sync,
+) -> Vec<HalfEdgeId> {
+    let edges: Vec<HalfEdgeId> = t.edges().collect();
+    let mut order: Vec<u128> = edges
+        .into_par_iter()
+        .filter_map(|h| {
+            let key = key(h)?;
+            debug_assert!(key >= 0.0);
+            Some((u128::from(!key.to_bits()) << 32) | h.index() as u128)
+        })
+        .collect();
+    order.par_sort_unstable();
+    order
+        .into_iter()
+        .map(|k| HalfEdgeId::new(k as u32))
+        .collect()
 }
 
 fn pair_up(partner: &mut [u32], f: TriangleId, n: TriangleId) {
@@ -220,18 +237,19 @@ const MIN_GREEDY_CORNER: f64 = 0.01;
 
 /// The paper's triquad. A sort stands in for the max-heap: the keys never change.
 fn greedy(t: &Triangulation) -> Vec<u32> {
-    let mut candidates: Vec<(f64, HalfEdgeId)> = t
-        .edges()
-        .filter(|&h| quad_across(t, h).is_some())
-        .map(|h| {
-            let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
-            (a.distance_squared(b), h)
-        })
-        .collect();
-    sort_best_first(&mut candidates);
+    // Only the edges whose quad is strictly convex enough: testing it here, in parallel,
+    // rather than when the edge's turn comes, leaves the same pairs.
+    let candidates = best_first(t, |h| {
+        let q = quad_across(t, h)?;
+        if !strictly_convex(&q) || scaled_jacobian(&q) < MIN_GREEDY_CORNER {
+            return None;
+        }
+        let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+        Some(a.distance_squared(b))
+    });
     let mut partner = vec![NONE; t.num_triangle_slots()];
     let mut marked = vec![false; 3 * t.num_triangle_slots()];
-    for (_, h) in candidates {
+    for h in candidates {
         if marked[h.index()] {
             continue;
         }
@@ -239,10 +257,6 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
             continue;
         };
         if partner[f.index()] != NONE || partner[n.index()] != NONE {
-            continue;
-        }
-        let Some(q) = quad_across(t, h) else { continue };
-        if !strictly_convex(&q) || scaled_jacobian(&q) < MIN_GREEDY_CORNER {
             continue;
         }
         pair_up(&mut partner, f, n);
@@ -301,11 +315,9 @@ fn matching(t: &Triangulation, min_corner: f64) -> Vec<u32> {
                 && good(h).is_some_and(|w| w >= KEEP_PAIR)
         })
     };
-    let mut candidates: Vec<(f64, HalfEdgeId)> =
-        t.edges().filter_map(|h| good(h).map(|w| (w, h))).collect();
-    sort_best_first(&mut candidates);
+    let candidates = best_first(t, good);
     let mut partner = vec![NONE; t.num_triangle_slots()];
-    for &(_, h) in &candidates {
+    for &h in &candidates {
         let (f, Some(n)) = (t.triangle_of(h), t.neighbour(h)) else {
             continue;
         };

@@ -49,6 +49,8 @@ pub struct ControlNet {
     pub patches: Vec<[u32; 16]>,
     /// Index of the first inner control point of each M edge (`+ 1` is the second).
     edge_base: u32,
+    /// Index of the first of the elements' inner control points.
+    inner_base: u32,
 }
 
 impl ControlNet {
@@ -65,6 +67,7 @@ impl ControlNet {
             points.push(a + (b - a) * (1.0 / 3.0));
             points.push(a + (b - a) * (2.0 / 3.0));
         }
+        let inner_base = points.len() as u32;
         let mut patches = Vec::with_capacity(m.elements.len());
         for (k, element) in m.elements.iter().enumerate() {
             let mut slots = [u32::MAX; 16];
@@ -106,6 +109,7 @@ impl ControlNet {
             points,
             patches,
             edge_base,
+            inner_base,
         }
     }
 
@@ -119,6 +123,14 @@ impl ControlNet {
         along.map(|slot| self.points[self.patches[k][slot] as usize])
     }
 
+    /// The control points apart: those on the elements' sides (corners and edge points), all
+    /// before the elements' inner ones (each element's consecutive, from its slot 5), and the
+    /// patches.
+    pub(crate) fn split_inner(&mut self) -> (&[Point], &mut [Point], &[[u32; 16]]) {
+        let (boundary, inner) = self.points.split_at_mut(self.inner_base as usize);
+        (boundary, inner, &self.patches)
+    }
+
     /// The inner control points of M edge `e` (at 1/3 and 2/3 along its direction).
     pub fn edge_inner(&self, e: u32) -> [u32; 2] {
         [self.edge_base + 2 * e, self.edge_base + 2 * e + 1]
@@ -127,14 +139,17 @@ impl ControlNet {
     /// [`ControlNet::eval_weights`] for the nonzero weights only, `(slot, weight)` in slot order
     /// (as [`crate::Template::terms`] has them): the same sum, term for term.
     pub fn eval_terms(&self, k: usize, terms: &[(u8, f64)]) -> Point {
-        let slots = &self.patches[k];
-        let (mut x, mut y) = (0.0, 0.0);
-        for &(slot, w) in terms {
-            let p = self.points[slots[usize::from(slot)] as usize];
-            x += w * p.x;
-            y += w * p.y;
-        }
-        Point::new(x, y)
+        eval_patch_terms(&self.patch_points(k), terms)
+    }
+
+    /// Element `k`'s control points by slot (a triangle's six unused slots are the origin).
+    pub fn patch_points(&self, k: usize) -> [Point; 16] {
+        self.patches[k].map(|slot| {
+            self.points
+                .get(slot as usize)
+                .copied()
+                .unwrap_or(Point::new(0.0, 0.0))
+        })
     }
 
     /// The point of element `k`'s patch for precomputed basis weights (see [`basis`]).
@@ -161,34 +176,55 @@ impl ControlNet {
     /// straight boundaries and follow curved ones smoothly.
     pub fn relax_inner(&mut self, element: &Element, k: usize) {
         let slots = self.patches[k];
-        let points = &self.points;
-        let p = |slot: usize| points[slots[slot] as usize];
-        let mut inner = [(0usize, Point::new(0.0, 0.0)); 4];
-        let count = match element {
-            Element::Triangle(_) => {
-                let edges = [1, 2, 6, 8, 7, 4]
-                    .iter()
-                    .fold(Point::new(0.0, 0.0), |s, &x| s + p(x));
-                let corners = p(0) + p(3) + p(9);
-                inner[0] = (5, edges * 0.25 - corners * (1.0 / 6.0));
-                1
-            }
-            Element::Quad(_) => {
-                for (n, slot) in QUAD_INNER.into_iter().enumerate() {
-                    let (i, j) = (slot % 4, slot / 4);
-                    let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
-                    let ruled_s = p(4 * j) * (1.0 - u) + p(3 + 4 * j) * u;
-                    let ruled_t = p(i) * (1.0 - v) + p(i + 12) * v;
-                    let corners = bilinear(&[p(0), p(3), p(15), p(12)], u, v);
-                    inner[n] = (slot, ruled_s + ruled_t - corners);
-                }
-                4
-            }
-        };
+        let (inner, count) = relaxed_inner(element, &self.patch_points(k));
         for &(slot, point) in &inner[..count] {
             self.points[slots[slot] as usize] = point;
         }
     }
+}
+
+/// [`ControlNet::relax_inner`] of the patch with control points `patch` (by slot): the inner
+/// slots and their new points (`count` of the four).
+pub(crate) fn relaxed_inner(
+    element: &Element,
+    patch: &[Point; 16],
+) -> ([(usize, Point); 4], usize) {
+    let p = |slot: usize| patch[slot];
+    let mut inner = [(0usize, Point::new(0.0, 0.0)); 4];
+    let count = match element {
+        Element::Triangle(_) => {
+            let edges = [1, 2, 6, 8, 7, 4]
+                .iter()
+                .fold(Point::new(0.0, 0.0), |s, &x| s + p(x));
+            let corners = p(0) + p(3) + p(9);
+            inner[0] = (5, edges * 0.25 - corners * (1.0 / 6.0));
+            1
+        }
+        Element::Quad(_) => {
+            for (n, slot) in QUAD_INNER.into_iter().enumerate() {
+                let (i, j) = (slot % 4, slot / 4);
+                let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
+                let ruled_s = p(4 * j) * (1.0 - u) + p(3 + 4 * j) * u;
+                let ruled_t = p(i) * (1.0 - v) + p(i + 12) * v;
+                let corners = bilinear(&[p(0), p(3), p(15), p(12)], u, v);
+                inner[n] = (slot, ruled_s + ruled_t - corners);
+            }
+            4
+        }
+    };
+    (inner, count)
+}
+
+/// The point of the patch with control points `patch` (by slot) for the nonzero basis
+/// weights `terms` (see [`ControlNet::eval_terms`]).
+pub(crate) fn eval_patch_terms(patch: &[Point; 16], terms: &[(u8, f64)]) -> Point {
+    let (mut x, mut y) = (0.0, 0.0);
+    for &(slot, w) in terms {
+        let p = patch[usize::from(slot)];
+        x += w * p.x;
+        y += w * p.y;
+    }
+    Point::new(x, y)
 }
 
 /// The Bernstein basis of a triangle (10 slots, the rest 0) or quad (16 slots) patch at
