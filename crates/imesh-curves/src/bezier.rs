@@ -272,6 +272,96 @@ pub fn fit_cubic(points: &[Point], options: &FitOptions) -> CurveFit {
     }
 }
 
+/// Fits a cubic Bézier to the chain `points` (at least two) whose ends leave the chain's ends
+/// along the given directions: `start` from the first point, `end` from the last (into the
+/// curve; any length, not zero). The arms' lengths (`|P₁ − P₀|`, `|P₂ − P₃|`) are `arms` where
+/// given, else fitted (least squares, then a few reprojections, as Schneider's fit does); an
+/// arm a chain of fewer than four points does not determine is a third of the chord. `None`
+/// when a fitted arm is not positive (the curve would leave the other way).
+///
+/// ```
+/// use imesh_curves::fit_cubic_with_tangents;
+/// use imesh_geom::Point;
+/// // A quarter circle, its end tangents given: the classic four-point approximation.
+/// let arc: Vec<Point> = (0..=24)
+///     .map(|i| { let a = std::f64::consts::FRAC_PI_2 * f64::from(i) / 24.0; Point::new(a.cos(), a.sin()) })
+///     .collect();
+/// let fit = fit_cubic_with_tangents(&arc, Point::new(0.0, 1.0), Point::new(1.0, 0.0), [None, None]).unwrap();
+/// assert!(fit.max_error < 1e-3);
+/// assert!((fit.curve.control[1].y - 0.5523).abs() < 1e-3); // the known 0.5523 of the radius
+/// // The first arm held at 0.3: the second makes up for it.
+/// let held = fit_cubic_with_tangents(&arc, Point::new(0.0, 1.0), Point::new(1.0, 0.0), [Some(0.3), None]).unwrap();
+/// assert_eq!(held.curve.control[1], Point::new(1.0, 0.3));
+/// assert!(held.max_error < 0.05);
+/// ```
+pub fn fit_cubic_with_tangents(
+    points: &[Point],
+    start: Point,
+    end: Point,
+    arms: [Option<f64>; 2],
+) -> Option<CurveFit> {
+    let n = points.len();
+    let (p0, p3) = (points.first().copied()?, points.last().copied()?);
+    let unit = |d: Point| {
+        let len = (d.x * d.x + d.y * d.y).sqrt();
+        (len > 0.0 && len.is_finite()).then(|| d * (1.0 / len))
+    };
+    let (u, w) = (unit(start)?, unit(end)?);
+    let third = p0.distance_squared(p3).sqrt() / 3.0;
+    let curve_of = |a: f64, b: f64| CubicBezier::new([p0, p0 + u * a, p3 + w * b, p3]);
+    let mut t = chord_length(points);
+    let mut lengths = (arms[0].unwrap_or(third), arms[1].unwrap_or(third));
+    for refit in 0..=TANGENT_REFITS {
+        if n < 4 || (arms[0].is_some() && arms[1].is_some()) {
+            break;
+        }
+        // Σ |α B₁ u + β B₂ w − rᵢ|² over the inner points, rᵢ the point less the ends' part;
+        // a given arm moves to the right-hand side.
+        let (mut a11, mut a12, mut a22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for (&p, &ti) in points[1..n - 1].iter().zip(&t[1..n - 1]) {
+            let s = 1.0 - ti;
+            let (c0, c1, c2, c3) = (s * s * s, 3.0 * s * s * ti, 3.0 * s * ti * ti, ti * ti * ti);
+            let mut r = p - p0 * (c0 + c1) - p3 * (c2 + c3);
+            let (x, y) = (u * c1, w * c2);
+            if let Some(a) = arms[0] {
+                r = r - x * a;
+            }
+            if let Some(b) = arms[1] {
+                r = r - y * b;
+            }
+            a11 += x.x * x.x + x.y * x.y;
+            a12 += x.x * y.x + x.y * y.y;
+            a22 += y.x * y.x + y.y * y.y;
+            b1 += x.x * r.x + x.y * r.y;
+            b2 += y.x * r.x + y.y * r.y;
+        }
+        let solved = match arms {
+            [Some(a), None] => (a22 > 0.0).then(|| (a, b2 / a22)),
+            [None, Some(b)] => (a11 > 0.0).then(|| (b1 / a11, b)),
+            _ => {
+                let det = a11 * a22 - a12 * a12;
+                (det.abs() > 1e-12 * (a11 * a22).max(f64::MIN_POSITIVE))
+                    .then(|| ((b1 * a22 - b2 * a12) / det, (a11 * b2 - a12 * b1) / det))
+            }
+        };
+        let Some(solved) = solved else { break };
+        lengths = solved;
+        // The points' projections on the new curve are its next parameters (a first curve may
+        // be far from the chord-length guesses: a global search).
+        measure(curve_of(lengths.0, lengths.1), points, &mut t, refit > 0);
+    }
+    let (a, b) = lengths;
+    if !(a > 0.0 && b > 0.0 && a.is_finite() && b.is_finite()) {
+        return None;
+    }
+    let mut fit = measure(curve_of(a, b), points, &mut t, false);
+    fit.curve_deviation = curve_deviation(&fit.curve, points, &t);
+    Some(fit)
+}
+
+/// Reprojections of [`fit_cubic_with_tangents`] after its first fit.
+const TANGENT_REFITS: usize = 4;
+
 /// The least-squares cubic through `points` at the given parameters `t` (one per point,
 /// `t[0] = 0`, last 1, increasing): ends fixed, inner control points by QR. Points sampled from a
 /// cubic at their parameters give that cubic back. `None` when fewer than four points or the

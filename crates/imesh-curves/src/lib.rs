@@ -13,7 +13,10 @@
 //!   remembers the chain of original vertices it replaces;
 //! - [`CubicBezier`] and [`fit_cubic`]: de Casteljau evaluation and exact splitting, and the
 //!   least-squares cubic through a chain with its ends fixed; [`fit_edges`] fits every edge of
-//!   G' and reports the errors.
+//!   G' and reports the errors;
+//! - [`open_sharp_corners`]: where two boundaries leave a vertex closer than a quad corner
+//!   should be (30°), the curves' ends turned apart within the tolerance
+//!   ([`fit_cubic_with_tangents`]).
 //!
 //! ```
 //! use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
@@ -33,6 +36,7 @@
 
 mod bezier;
 mod contract;
+mod corners;
 mod distance;
 mod faces;
 mod graph;
@@ -42,8 +46,11 @@ mod simplify;
 
 use rayon::prelude::*;
 
-pub use bezier::{fit_cubic, fit_cubic_at, CubicBezier, CurveFit, FitOptions};
+pub use bezier::{
+    fit_cubic, fit_cubic_at, fit_cubic_with_tangents, CubicBezier, CurveFit, FitOptions,
+};
 pub use contract::{contract_short_links, Contraction};
+pub use corners::{open_sharp_corners, CornerOptions, CornerReport, MIN_CORNER_DEG};
 pub use distance::{segment_distance, segment_distance_squared, segment_parameter};
 pub use graph::{CurveGraph, Face, GraphEdge};
 pub use grid::SegmentIndex;
@@ -119,23 +126,30 @@ pub fn fit_edges(s: &Simplification, original: &CurveGraph, options: &FitOptions
             fit_cubic(chain_points, options)
         })
         .collect();
-    let mut max_error: f64 = 0.0;
-    let mut max_curve_deviation: f64 = 0.0;
-    let (mut sum, mut count) = (0.0, 0usize);
-    for (fit, chain) in fits.iter().zip(&s.chains) {
-        max_error = max_error.max(fit.max_error);
-        max_curve_deviation = max_curve_deviation.max(fit.curve_deviation);
-        sum += fit.rms_error * fit.rms_error * chain.len() as f64;
-        count += chain.len();
-    }
-    FitReport {
-        fits,
-        max_error,
-        rms_error: if count > 0 {
-            (sum / count as f64).sqrt()
-        } else {
-            0.0
-        },
-        max_curve_deviation,
+    FitReport::of(fits, &s.chains)
+}
+
+impl FitReport {
+    /// The report of `fits`, one per chain of `chains`.
+    fn of(fits: Vec<CurveFit>, chains: &[Vec<u32>]) -> Self {
+        let mut max_error: f64 = 0.0;
+        let mut max_curve_deviation: f64 = 0.0;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (fit, chain) in fits.iter().zip(chains) {
+            max_error = max_error.max(fit.max_error);
+            max_curve_deviation = max_curve_deviation.max(fit.curve_deviation);
+            sum += fit.rms_error * fit.rms_error * chain.len() as f64;
+            count += chain.len();
+        }
+        FitReport {
+            fits,
+            max_error,
+            rms_error: if count > 0 {
+                (sum / count as f64).sqrt()
+            } else {
+                0.0
+            },
+            max_curve_deviation,
+        }
     }
 }

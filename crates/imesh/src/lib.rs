@@ -24,8 +24,8 @@ use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
 use imesh_curves::{
-    contract_short_links, fit_edges, neck_vertices, sharp_vertices, simplify, CurveGraph,
-    FitOptions, GraphEdge, Simplification, SimplifyOptions,
+    contract_short_links, fit_edges, neck_vertices, open_sharp_corners, sharp_vertices, simplify,
+    CornerOptions, CurveGraph, FitOptions, GraphEdge, Simplification, SimplifyOptions,
 };
 use imesh_geom::{RefineOptions, StopReason, TriangleId, Triangulation, VertexId};
 use imesh_io::SegmentedMeshData;
@@ -472,6 +472,12 @@ pub struct Counts {
     /// Boundary vertices kept where simplification would have narrowed a face below
     /// [`NECK_SHARE`] quad sides.
     pub kept_at_necks: usize,
+    /// Sectors of G' narrower than [`imesh_curves::MIN_CORNER_DEG`] between two boundaries
+    /// (about a quad side from their vertex), which [`imesh_curves::open_sharp_corners`] tried
+    /// to widen.
+    pub opened_corners: usize,
+    /// Curves it refitted with turned ends, within the curve tolerance of their boundaries.
+    pub turned_curves: usize,
     /// Boundary vertices kept where two simplified edges would have left a vertex less than
     /// [`imesh_curves::SHARP_SECTOR_DEG`] apart though the boundaries leave it wider
     /// ([`imesh_curves::sharp_vertices`], at [`SHARP_LENGTH`] quad sides from it).
@@ -1349,7 +1355,26 @@ impl Pipeline {
         counts.contracted_links = contracted;
         counts.kept_at_necks = necks;
         counts.kept_at_sharp_sectors = sharp;
-        let fits = fit_edges(&simplified, &g, &FitOptions::default());
+        let mut fits = fit_edges(&simplified, &g, &FitOptions::default());
+        // Sharp corners opened within the tolerance, measured about one quad side out (where
+        // the first element edge along a boundary ends); the image's border stays straight.
+        let corners = open_sharp_corners(
+            &simplified,
+            &g,
+            &mut fits,
+            &CornerOptions {
+                tolerance: self.tolerance(),
+                reach: quad_size.unwrap_or(self.tolerance()),
+                ..CornerOptions::default()
+            },
+            |k| {
+                simplified.graph.edges()[k as usize]
+                    .labels
+                    .contains(&OUTSIDE)
+            },
+        );
+        counts.opened_corners = corners.sharp;
+        counts.turned_curves = corners.refitted;
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
         let fitting = start.elapsed().as_secs_f64();
         seconds.curves += fitting;

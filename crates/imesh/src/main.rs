@@ -614,11 +614,11 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             );
         }
         println!("{line}");
-        // A worst corner the boundaries force: say so, and where (the image's own corner).
+        // A worst corner the boundaries force: say so, and where.
         if let Some(corner) = report.sharpest_boundary_corner {
             if q.scaled_jacobian().min >= corner.scaled_jacobian - 1e-9 {
                 println!(
-                    "the worst scaled Jacobian is the image's own corner: {:.1}° between two boundaries at ({:.1}, {:.1}) px, which the quad there must keep",
+                    "the worst scaled Jacobian is a corner of {:.1}° between two boundaries at ({:.1}, {:.1}) px, which the quad there must keep (sharp in the image, and not widened within the curve tolerance)",
                     corner.angle_deg, corner.at[0], corner.at[1]
                 );
             }

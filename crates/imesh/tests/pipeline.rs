@@ -116,8 +116,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             r.label_agreement
         );
         // A corner between two boundary edges fills a sector alone: its sine bounds the worst
-        // scaled Jacobian; on seven of the ten the worst is such a corner (brick's can still
-        // turn, and coins' and stardist's are over 0.5).
+        // scaled Jacobian; on six of the ten the worst is such a corner, where the curves could
+        // not be turned wider within the tolerance or adaptation straightened them again (brick's
+        // can still turn, coffee's worst lies in a strip a pixel wide, and coins' and
+        // stardist's are over 0.5).
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -129,6 +131,19 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         if worst >= corner.scaled_jacobian - 1e-9 {
             at_the_bound += 1;
+        }
+        if path.ends_with("pyvista-channels_z050_labels.png")
+            || path.ends_with("skimage-gravel.png")
+        {
+            // Boundaries met at 16° and 17°: turned apart within the tolerance (the worst
+            // scaled Jacobian was 0.275 and 0.294 with the curves as fitted).
+            assert!(r.counts.opened_corners > 0 && r.counts.turned_curves > 0);
+            assert!(
+                r.quality.scaled_jacobian().min > 0.4,
+                "{}: worst scaled Jacobian {}",
+                path.display(),
+                r.quality.scaled_jacobian().min
+            );
         }
         if path.ends_with("skimage-brick.png") {
             // Simplified, boundaries met the border and each other at 8–15°; the boundaries'
@@ -155,7 +170,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_the_bound >= 7, "{at_the_bound}");
+    assert!(at_the_bound >= 6, "{at_the_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
