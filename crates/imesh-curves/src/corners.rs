@@ -199,7 +199,7 @@ fn turned(
                     continue;
                 }
                 let made = match (before[i], chord(&fit.curve, at_start, reach)) {
-                    (Some(a), Some(b)) => (a.x * b.y - a.y * b.x).atan2(a.x * b.x + a.y * b.y),
+                    (Some(a), Some(b)) => angle_between(a, b),
                     _ => f64::NEG_INFINITY,
                 };
                 share = share.min(made / turn[i]);
@@ -317,6 +317,11 @@ fn tangent(fit: &CurveFit, at_start: bool) -> Option<Point> {
         .find(|d| d.x != 0.0 || d.y != 0.0)
 }
 
+/// The angle (radians, counter-clockwise positive) from direction `a` to direction `b`.
+fn angle_between(a: Point, b: Point) -> f64 {
+    (a.x * b.y - a.y * b.x).atan2(a.x * b.x + a.y * b.y)
+}
+
 /// `d` turned by `angle` radians counter-clockwise.
 fn rotate(d: Point, angle: f64) -> Point {
     let (sin, cos) = angle.sin_cos();
@@ -375,18 +380,20 @@ mod tests {
                 chord(&fits.fits[k as usize].curve, at_start, reach)
             })
             .collect();
-        let (a, b) = (dirs[0], dirs[1]);
-        (a.x * b.y - a.y * b.x)
-            .atan2(a.x * b.x + a.y * b.y)
-            .abs()
-            .to_degrees()
+        angle_between(dirs[0], dirs[1]).abs().to_degrees()
+    }
+
+    /// [`wedge`] simplified at a tolerance of 1 px, and its fitted curves.
+    fn fitted(angle_deg: f64, n: u32, step: f64) -> (CurveGraph, Simplification, FitReport) {
+        let g = wedge(angle_deg, n, step);
+        let s = simplify(&g, &SimplifyOptions::with_tolerance(1.0)).expect("simplifies");
+        let fits = fit_edges(&s, &g, &FitOptions::default());
+        (g, s, fits)
     }
 
     #[test]
     fn wide_sectors_are_left_alone() {
-        let g = wedge(50.0, 10, 2.0);
-        let s = simplify(&g, &SimplifyOptions::with_tolerance(1.0)).expect("simplifies");
-        let mut fits = fit_edges(&s, &g, &FitOptions::default());
+        let (g, s, mut fits) = fitted(50.0, 10, 2.0);
         let before = fits.clone();
         let report = open_sharp_corners(&s, &g, &mut fits, &CornerOptions::default(), |_| false);
         assert_eq!(report, CornerReport::default());
@@ -395,9 +402,7 @@ mod tests {
 
     #[test]
     fn a_fixed_side_stays_and_the_other_turns_alone() {
-        let g = wedge(15.0, 12, 2.0);
-        let s = simplify(&g, &SimplifyOptions::with_tolerance(1.0)).expect("simplifies");
-        let mut fits = fit_edges(&s, &g, &FitOptions::default());
+        let (g, s, mut fits) = fitted(15.0, 12, 2.0);
         let before = fits.clone();
         // The x axis's side is the domain's border.
         let on_axis = |k: u32| {
@@ -431,9 +436,7 @@ mod tests {
         /// 2 px or more), the tip opens to the angle asked for.
         #[test]
         fn spikes_open_within_the_tolerance(angle in 6.0f64..28.0, n in 3u32..14, step in 0.5f64..3.0) {
-            let g = wedge(angle, n, step);
-            let s = simplify(&g, &SimplifyOptions::with_tolerance(1.0)).expect("simplifies");
-            let mut fits = fit_edges(&s, &g, &FitOptions::default());
+            let (g, s, mut fits) = fitted(angle, n, step);
             let before = fits.clone();
             let options = CornerOptions { tolerance: 1.0, ..CornerOptions::default() };
             let report = open_sharp_corners(&s, &g, &mut fits, &options, |_| false);
