@@ -9,6 +9,7 @@
 //! within the tolerance of its chain.
 
 use imesh_geom::Point;
+use rayon::prelude::*;
 
 use crate::bezier::{fit_cubic_with_tangents, CubicBezier, CurveFit};
 use crate::simplify::Simplification;
@@ -146,15 +147,19 @@ pub fn open_sharp_corners(
             turns[e.edge as usize][usize::from(!e.at_start)] = e.turn;
         }
     }
-    for (k, turn) in turns.iter().enumerate() {
-        if turn[0] == 0.0 && turn[1] == 0.0 {
-            continue;
-        }
-        let chain: Vec<Point> = s.chains[k].iter().map(|&v| original.point(v)).collect();
-        if let Some(fit) = turned(&chain, &fits.fits[k], *turn, tolerance, reach) {
-            fits.fits[k] = fit;
-            report.refitted += 1;
-        }
+    // Each turned curve is refitted on its own: in parallel, kept in edge order.
+    let refits: Vec<(usize, CurveFit)> = turns
+        .par_iter()
+        .enumerate()
+        .filter(|(_, turn)| turn[0] != 0.0 || turn[1] != 0.0)
+        .filter_map(|(k, turn)| {
+            let chain: Vec<Point> = s.chains[k].iter().map(|&v| original.point(v)).collect();
+            turned(&chain, &fits.fits[k], *turn, tolerance, reach).map(|fit| (k, fit))
+        })
+        .collect();
+    report.refitted = refits.len();
+    for (k, fit) in refits {
+        fits.fits[k] = fit;
     }
     if report.refitted > 0 {
         *fits = FitReport::of(std::mem::take(&mut fits.fits), &s.chains);
