@@ -261,18 +261,17 @@ fn chord(curve: &CubicBezier, at_start: bool, reach: f64) -> Option<Point> {
 /// Samples of [`chord`]'s search.
 const CHORD_SAMPLES: u32 = 64;
 
-/// Widens the sectors between consecutive `ends` (sorted by angle, counter-clockwise) that are
-/// narrower than `min`, each end turning once.
+/// Widens the sectors between consecutive `ends` (two or more, sorted by angle,
+/// counter-clockwise) that are narrower than `min`, each end turning once.
 fn open_sectors(ends: &mut [End], min: f64, report: &mut CornerReport) {
     let n = ends.len();
     let tau = std::f64::consts::TAU;
-    // The sector from end i to end i + 1, counter-clockwise (as turned so far).
+    // The sector from end i to end i + 1, counter-clockwise (as turned so far; the last wraps
+    // round to the first).
     let width = |ends: &[End], i: usize| {
         let (a, b) = (&ends[i], &ends[(i + 1) % n]);
         let w = (b.angle + b.turn) - (a.angle + a.turn);
-        if n == 1 {
-            tau
-        } else if i + 1 == n {
+        if i + 1 == n {
             w + tau
         } else {
             w

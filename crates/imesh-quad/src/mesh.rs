@@ -299,22 +299,10 @@ impl QuadMesh {
     /// Re-evaluates the inner template points of element `index` (those on no side) from its
     /// patch: all that changes when only its inner control points move.
     pub fn evaluate_inside(&mut self, m: &ElementMesh, net: &ControlNet, index: usize) {
-        let range = self.inside_range(index);
-        let ids = &self.points[self.point_first[index] as usize..];
-        let kind = usize::from(matches!(m.elements[index], Element::Quad(_)));
-        inside_points(
-            &self.templates[kind],
-            &self.inside_places[kind],
-            ids,
-            range.start as u32,
-            &net.patch_points(index),
-            &mut self.vertices[range],
-        );
-    }
-
-    /// The inner vertices of element `index` (consecutive).
-    fn inside_range(&self, index: usize) -> std::ops::Range<usize> {
-        self.inside_first[index] as usize..self.inside_first[index + 1] as usize
+        let (this, mut slices) = InsideView::split(self, &[index]);
+        if let Some(out) = slices.pop() {
+            this.evaluate(m, index, &net.patch_points(index), out);
+        }
     }
 
     /// [`QuadMesh::evaluate_inside`] for each of `elements` (increasing), in parallel: each
