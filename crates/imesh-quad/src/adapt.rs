@@ -192,34 +192,38 @@ pub fn adapt(
     let mut curve_round = vec![0u32; g.edges().len()];
     let mut element_round = vec![0u32; m.elements.len()];
     // The elements a G' edge's damping moves: those on both sides of its pieces, and all
-    // around their (Steiner) ends.
-    let moved_by: Vec<Vec<u32>> = pieces
-        .par_iter()
-        .map(|pieces| {
-            let mut elements = Vec::new();
-            for &p in pieces {
-                let h = m.edges[adapted[p as usize].edge as usize];
-                let around = |v: VertexId| {
-                    (dt.graph_vertex[v.index()] == NONE)
-                        .then(|| t.vertex_triangles(v))
-                        .into_iter()
-                        .flatten()
-                };
-                let sides = [t.triangle_of(h), t.triangle_of(t.twin(h))];
-                elements.extend(
-                    sides
-                        .into_iter()
-                        .chain(around(t.origin(h)))
-                        .chain(around(t.destination(h)))
-                        .filter_map(|f| m.element_of_triangle.get(f.index()).copied())
-                        .filter(|&el| el != NONE),
-                );
-            }
-            elements.sort_unstable();
-            elements.dedup();
-            elements
-        })
-        .collect();
+    // around their (Steiner) ends; only needed if something is to be repaired.
+    let moved_by: Vec<Vec<u32>> = if bad.is_empty() {
+        Vec::new()
+    } else {
+        pieces
+            .par_iter()
+            .map(|pieces| {
+                let mut elements = Vec::new();
+                for &p in pieces {
+                    let h = m.edges[adapted[p as usize].edge as usize];
+                    let around = |v: VertexId| {
+                        (dt.graph_vertex[v.index()] == NONE)
+                            .then(|| t.vertex_triangles(v))
+                            .into_iter()
+                            .flatten()
+                    };
+                    let sides = [t.triangle_of(h), t.triangle_of(t.twin(h))];
+                    elements.extend(
+                        sides
+                            .into_iter()
+                            .chain(around(t.origin(h)))
+                            .chain(around(t.destination(h)))
+                            .filter_map(|f| m.element_of_triangle.get(f.index()).copied())
+                            .filter(|&el| el != NONE),
+                    );
+                }
+                elements.sort_unstable();
+                elements.dedup();
+                elements
+            })
+            .collect()
+    };
     let mut relaxed = vec![false; m.elements.len()];
     let mut damped = vec![false; g.edges().len()];
     let mut weight = vec![1.0f64; g.edges().len()];

@@ -434,9 +434,11 @@ struct InsideView<'a> {
 impl<'a> InsideView<'a> {
     /// The view of `q`, and the slices of `q`'s inner vertices of `elements` (increasing).
     fn split(q: &'a mut QuadMesh, elements: &[usize]) -> (Self, Vec<&'a mut [Point]>) {
-        let first = q.corner_count as usize + (2 * q.level as usize - 1) * q.edge_ends.len();
-        let (_, inner) = q.vertices.split_at_mut(first);
+        // The inner vertices of all come after the corners and edge points, the first
+        // element's first.
         let inside_first = &q.inside_first;
+        let first = inside_first[0] as usize;
+        let (_, inner) = q.vertices.split_at_mut(first);
         let slices = disjoint_slices(
             inner,
             elements.iter().map(|&k| {

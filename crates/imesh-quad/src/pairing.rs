@@ -200,8 +200,17 @@ fn strictly_convex(q: &[Point; 4]) -> bool {
     (0..4).all(|i| orient2d(q[(i + 3) % 4], q[i], q[(i + 1) % 4]) > 0.0)
 }
 
-/// The half-edges of `candidates` by decreasing key, then increasing half-edge: the order of
-/// the paper's max-heap, made deterministic. The keys are lengths and corner sines, never
+/// The worst corner sine (scaled Jacobian) of the quad across `h` ([`quad_across`]) if it is
+/// strictly convex and that sine is at least `min_corner`.
+fn corner_sine(t: &Triangulation, h: HalfEdgeId, min_corner: f64) -> Option<f64> {
+    quad_across(t, h)
+        .filter(strictly_convex)
+        .map(|q| scaled_jacobian(&q))
+        .filter(|&w| w >= min_corner)
+}
+
+/// The edges of `t` that have a `key`, by decreasing key, then increasing half-edge: the order
+/// of the paper's max-heap, made deterministic. The keys are lengths and corner sines, never
 /// negative, so their bits sort as they do, and the pairs are all distinct: one integer per
 /// pair, the key's bits inverted above the half-edge's index, sorts into the one order
 /// without a comparator's branches.
@@ -240,10 +249,7 @@ fn greedy(t: &Triangulation) -> Vec<u32> {
     // Only the edges whose quad is strictly convex enough: testing it here, in parallel,
     // rather than when the edge's turn comes, leaves the same pairs.
     let candidates = best_first(t, |h| {
-        let q = quad_across(t, h)?;
-        if !strictly_convex(&q) || scaled_jacobian(&q) < MIN_GREEDY_CORNER {
-            return None;
-        }
+        corner_sine(t, h, MIN_GREEDY_CORNER)?;
         let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
         Some(a.distance_squared(b))
     });
@@ -302,12 +308,7 @@ const MAX_AUGMENTING_DEPTH: usize = 8;
 /// Best quads first, then augmenting paths for the triangles left; no quad with a corner sine
 /// under `min_corner`.
 fn matching(t: &Triangulation, min_corner: f64) -> Vec<u32> {
-    let good = |h: HalfEdgeId| {
-        quad_across(t, h)
-            .filter(strictly_convex)
-            .map(|q| scaled_jacobian(&q))
-            .filter(|&w| w >= min_corner)
-    };
+    let good = |h: HalfEdgeId| corner_sine(t, h, min_corner);
     // Whether the pair of `n` and its partner `p` is one an augmenting path keeps.
     let keeps = |n: TriangleId, p: u32| {
         t.triangle_edges(n).into_iter().any(|h| {
