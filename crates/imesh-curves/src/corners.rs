@@ -198,12 +198,12 @@ fn turned(
                 rotate(start, turn[0] * factor),
                 rotate(end, turn[1] * factor),
             );
-            let Some(fit) = fit_cubic_with_tangents(chain, start, end, arms)
-                .filter(|f| runs_forward(&f.curve))
-                .or_else(|| {
-                    fit_cubic_with_tangents(chain, start, end, arms.map(|a| a.or(Some(third))))
-                        .filter(|f| runs_forward(&f.curve))
-                })
+            let forward = |arms| {
+                fit_cubic_with_tangents(chain, start, end, arms).filter(|f| runs_forward(&f.curve))
+            };
+            let held = arms.map(|a| a.or(Some(third)));
+            let Some(fit) = forward(arms)
+                .or_else(|| (held != arms).then(|| forward(held)).flatten())
                 .filter(|f| f.hausdorff() <= bound)
             else {
                 continue;
