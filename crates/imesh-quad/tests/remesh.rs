@@ -187,7 +187,7 @@ fn adapted_boundary_vertices_lie_on_the_fitted_curves_and_near_the_chains() {
         let t = &r.dt.triangulation;
         let g = &c.simplified.graph;
         let mut checked = 0;
-        for ec in r.edge_curves.iter().filter(|ec| ec.weight == 1.0) {
+        for ec in r.edge_curves.iter().filter(|ec| ec.weights == [1.0, 1.0]) {
             let k = ec.graph_edge as usize;
             let curve = c.fits.fits[k].curve;
             let along = r.mesh.edge_vertices(t, &r.elements, ec.edge);
@@ -238,6 +238,49 @@ fn adaptation_never_makes_a_quad_poor() {
         damped += r.adaptation.damped_curves;
     }
     assert!(damped > 0);
+}
+
+#[test]
+fn damping_stays_near_the_quads_it_mends_and_keeps_shared_vertices_shared() {
+    let (mut partly, mut damped_pieces) = (0, 0);
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let r = run(&c, &QuadOptions::default());
+        let t = &r.dt.triangulation;
+        // Two pieces meeting at a DT' vertex put it at the same point, whatever each kept.
+        let mut at: HashMap<u32, Point> = HashMap::new();
+        let mut by_curve: HashMap<u32, (usize, usize)> = HashMap::new();
+        for ec in &r.edge_curves {
+            let h = r.elements.edges[ec.edge as usize];
+            let path = ec.path();
+            for (v, p) in [
+                (t.origin(h), path.eval(0.0)),
+                (t.destination(h), path.eval(1.0)),
+            ] {
+                let seen = *at.entry(v.index() as u32).or_insert(p);
+                assert_eq!(
+                    seen,
+                    p,
+                    "{name}: pieces disagree at DT' vertex {}",
+                    v.index()
+                );
+            }
+            assert!(ec.weights.iter().all(|w| (0.0..=1.0).contains(w)));
+            let entry = by_curve.entry(ec.graph_edge).or_default();
+            entry.0 += 1;
+            if ec.weights != [1.0, 1.0] {
+                entry.1 += 1;
+                damped_pieces += 1;
+            }
+        }
+        // Some G' edge keeps its curve on pieces away from a damped one.
+        partly += by_curve
+            .values()
+            .filter(|&&(all, damped)| damped > 0 && damped < all)
+            .count();
+    }
+    assert!(damped_pieces > 0);
+    assert!(partly > 0, "every damped G' edge was damped whole");
 }
 
 #[test]
