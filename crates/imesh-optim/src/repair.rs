@@ -185,22 +185,7 @@ fn compass(
     setup: &Setup,
     bar: f64,
 ) -> bool {
-    // The objective at the current position, or None where a quad is invalid or under a floor.
-    let value = |vertices: &[Point]| -> Option<(f64, f64)> {
-        let (mut jacobian, mut shape) = (bar, bar);
-        for &q in quads {
-            let p = setup.quads[q as usize].map(|u| vertices[u as usize]);
-            let (_, s) = setup.feasible_quality(q as usize, &p)?;
-            shape = shape.min(s);
-            // The scaled Jacobian is at least the shape: only a shape under the bar can leave
-            // it there.
-            if s < bar {
-                let j = imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y]));
-                jacobian = jacobian.min(j);
-            }
-        }
-        Some((jacobian, shape))
-    };
+    let value = |vertices: &[Point]| corners_value(quads, vertices, setup, bar);
     let Some(mut best) = value(vertices) else {
         return false;
     };
@@ -256,6 +241,30 @@ fn compass(
         }
     }
     moving.iter().zip(&start).any(|(&v, &p)| vertices[v] != p)
+}
+
+/// What the repair raises for `quads` over `vertices`: their smallest scaled Jacobian, then
+/// their smallest shape, both capped at `bar` (compared in that order); `None` where a quad is
+/// invalid or under a floor of `setup`.
+pub(crate) fn corners_value(
+    quads: &[u32],
+    vertices: &[Point],
+    setup: &Setup,
+    bar: f64,
+) -> Option<(f64, f64)> {
+    let (mut jacobian, mut shape) = (bar, bar);
+    for &q in quads {
+        let p = setup.quads[q as usize].map(|u| vertices[u as usize]);
+        let (_, s) = setup.feasible_quality(q as usize, &p)?;
+        shape = shape.min(s);
+        // The scaled Jacobian is at least the shape: only a shape under the bar can leave it
+        // there.
+        if s < bar {
+            let j = imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y]));
+            jacobian = jacobian.min(j);
+        }
+    }
+    Some((jacobian, shape))
 }
 
 #[cfg(test)]

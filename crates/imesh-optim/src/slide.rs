@@ -187,6 +187,74 @@ impl Sliders {
         done
     }
 
+    /// The worst corners next to the curves: each slider with a quad whose shape is under
+    /// `bar` moves along its curve, between its neighbours, to raise the smallest scaled
+    /// Jacobian of its quads and then their smallest shape (up to `bar`, every quad held to
+    /// the floors of `setup`; [`crate::repair::corners_value`]), by a coarse scan of the gap and
+    /// a search halving its step around the best. The free vertices' repair cannot turn a
+    /// corner pinned between two boundary vertices; moving one of those along the boundary
+    /// can. Sequential and in slider order; returns how many moved.
+    pub fn repair(&mut self, vertices: &mut [Point], setup: &Setup<'_>, bar: f64) -> usize {
+        let mut moved = 0;
+        for i in 0..self.slot.len() {
+            let quads = self.quads.row(i);
+            let poor = quads.iter().any(|&q| {
+                let p = setup.quads[q as usize]
+                    .map(|u| [vertices[u as usize].x, vertices[u as usize].y]);
+                imesh_quality::quad::shape(&p) < bar
+            });
+            if !poor {
+                continue;
+            }
+            let (c, j) = self.slot[i];
+            let (chain, along) = (&self.chains[c as usize], &mut self.along[c as usize]);
+            let v = chain.vertices[j as usize] as usize;
+            let (lo, hi) = (along[j as usize - 1], along[j as usize + 1]);
+            let margin = 0.05 * (hi - lo);
+            let (lo, hi) = (lo + margin, hi - margin);
+            let start = (along[j as usize], vertices[v]);
+            let mut value = |a: f64| {
+                vertices[v] = chain.point(a);
+                crate::repair::corners_value(quads, vertices, setup, bar)
+            };
+            let Some(mut best) = value(start.0) else {
+                vertices[v] = start.1;
+                continue;
+            };
+            let mut at = start.0;
+            let better = |f: Option<(f64, f64)>, best: (f64, f64)| {
+                f.is_some_and(|f| f.0 > best.0 || (f.0 == best.0 && f.1 > best.1))
+            };
+            for k in 0..=REPAIR_SCAN {
+                let a = lo + (hi - lo) * k as f64 / REPAIR_SCAN as f64;
+                let f = value(a);
+                if better(f, best) {
+                    (at, best) = (a, f.unwrap_or(best));
+                }
+            }
+            let mut step = (hi - lo) / REPAIR_SCAN as f64 / 2.0;
+            for _ in 0..REPAIR_HALVINGS {
+                for a in [at - step, at + step] {
+                    if (lo..=hi).contains(&a) {
+                        let f = value(a);
+                        if better(f, best) {
+                            (at, best) = (a, f.unwrap_or(best));
+                        }
+                    }
+                }
+                step /= 2.0;
+            }
+            if at == start.0 {
+                vertices[v] = start.1;
+            } else {
+                vertices[v] = chain.point(at);
+                along[j as usize] = at;
+                moved += 1;
+            }
+        }
+        moved
+    }
+
     /// The best position of slider `i` between its neighbours: golden-section search of the
     /// energy of its quads, from where it is. `None` when it cannot improve.
     fn solve(
@@ -243,6 +311,11 @@ impl Sliders {
         (after < before).then(|| (i as u32, best, chain.point(best), before, after))
     }
 }
+
+/// The repair's scan of a slider's gap: this many intervals, then the step (half an interval)
+/// halved this many times around the best.
+const REPAIR_SCAN: usize = 16;
+const REPAIR_HALVINGS: usize = 10;
 
 /// Golden-section steps per solve: the bracket shrinks to 0.618²⁰ ≈ 10⁻⁴ of the gap between
 /// the neighbours.

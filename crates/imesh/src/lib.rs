@@ -576,8 +576,10 @@ pub struct Optimisation {
     pub sweeps: usize,
     /// Quad vertices that slid along the boundary curves after the local or vertex mode.
     pub sliders: usize,
-    /// Quad vertices moved last to raise the worst scaled Jacobians (local or vertex mode).
+    /// Quad vertices moved last to raise the worst scaled Jacobians (local or vertex mode)...
     pub repaired: usize,
+    /// ... of which boundary vertices moved along their curves.
+    pub repaired_sliders: usize,
 }
 
 /// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
@@ -1554,6 +1556,7 @@ impl Pipeline {
                 sweeps: optimisation.sweeps,
                 sliders: optimisation.sliders,
                 repaired: optimisation.repaired,
+                repaired_sliders: optimisation.repaired_sliders,
             },
             before: optimisation.before,
             histograms: QualityHistograms {

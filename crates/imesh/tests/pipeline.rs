@@ -89,7 +89,7 @@ fn the_triangle_path_stays_available() {
 fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
     let images = support::fixtures();
     assert!(images.len() >= 10, "{images:?}");
-    let mut at_the_bound = 0;
+    let mut at_a_bound = 0;
     for path in images {
         let quads = Pipeline::new(MeshOptions::default())
             .run_path(&path)
@@ -116,10 +116,9 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             r.label_agreement
         );
         // A corner between two boundary edges fills a sector alone: its sine bounds the worst
-        // scaled Jacobian; on six of the ten the worst is such a corner, where the curves could
-        // not be turned wider within the tolerance or adaptation straightened them again (brick's
-        // can still turn, coffee's worst lies in a strip a pixel wide, and coins' and
-        // stardist's are over 0.5).
+        // scaled Jacobian; on nine of the ten the worst is either such a corner, where the
+        // curves could not be turned wider within the tolerance, or at the repair's bar of 0.5
+        // (coffee's worst lies in a strip a pixel wide).
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -129,8 +128,8 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             "{}",
             path.display()
         );
-        if worst >= corner.scaled_jacobian - 1e-9 {
-            at_the_bound += 1;
+        if worst >= corner.scaled_jacobian - 1e-9 || worst >= 0.5 {
+            at_a_bound += 1;
         }
         if path.ends_with("pyvista-channels_z050_labels.png")
             || path.ends_with("skimage-gravel.png")
@@ -170,7 +169,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_the_bound >= 6, "{at_the_bound}");
+    assert!(at_a_bound >= 8, "{at_a_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
