@@ -46,7 +46,7 @@ mod pairing;
 mod patch;
 mod template;
 
-pub use adapt::{adapt, AdaptReport, EdgeCurve, POOR_SCALED_JACOBIAN};
+pub use adapt::{adapt, adapt_within, AdaptReport, EdgeCurve, LOCAL_ROUNDS, POOR_SCALED_JACOBIAN};
 pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};

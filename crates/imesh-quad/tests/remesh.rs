@@ -8,9 +8,9 @@ use imesh_curves::{
 };
 use imesh_geom::Point;
 use imesh_quad::{
-    remesh, DensityOptions, Element, ElementMesh, Pairing, QuadError, QuadOptions, Remesh,
-    BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER,
-    POOR_SCALED_JACOBIAN,
+    adapt_within, remesh, ControlNet, DensityOptions, Element, ElementMesh, Pairing, QuadError,
+    QuadMesh, QuadOptions, Remesh, BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER,
+    MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -281,6 +281,53 @@ fn damping_stays_near_the_quads_it_mends_and_keeps_shared_vertices_shared() {
     }
     assert!(damped_pieces > 0);
     assert!(partly > 0, "every damped G' edge was damped whole");
+}
+
+/// With no local rounds, adaptation straightens every G' edge a poor element needs damped,
+/// whole: still no quad poor or invalid, and less of the curves kept than by the default
+/// damping near the poor elements.
+#[test]
+fn straightening_whole_curves_is_the_blunt_fallback() {
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let r = run(&c, &QuadOptions::default());
+        let t = &r.dt.triangulation;
+        let fitted: Vec<_> = c.fits.fits.iter().map(|f| f.curve).collect();
+        let mut net = ControlNet::straight(t, &r.elements);
+        let mut mesh = QuadMesh::build(t, &r.elements, &net, 1);
+        let straight = mesh.clone();
+        let g = &c.simplified.graph;
+        let (report, pieces) = adapt_within(&r.dt, g, &fitted, &r.elements, &mut net, &mut mesh, 0);
+        assert_eq!(report.invalid_left, 0, "{name}");
+        assert!(report.damped_curves > 0, "{name}");
+        for x in 0..mesh.quads.len() {
+            let (after, before) = (mesh.scaled_jacobian(x), straight.scaled_jacobian(x));
+            assert!(
+                after >= POOR_SCALED_JACOBIAN.min(before) - 1e-9,
+                "{name}: quad {x}"
+            );
+        }
+        let mut whole: HashMap<u32, Vec<[f64; 2]>> = HashMap::new();
+        for ec in &pieces {
+            whole.entry(ec.graph_edge).or_default().push(ec.weights);
+        }
+        for (k, weights) in &whole {
+            let damped = weights.iter().any(|w| *w != [1.0, 1.0]);
+            assert!(
+                !damped || weights.iter().all(|w| *w == [0.0, 0.0]),
+                "{name}: G' edge {k} damped in part: {weights:?}"
+            );
+        }
+        let kept = |pieces: &[imesh_quad::EdgeCurve]| -> f64 {
+            pieces.iter().map(|ec| ec.weights[0] + ec.weights[1]).sum()
+        };
+        assert!(
+            kept(&r.edge_curves) > kept(&pieces),
+            "{name}: {} vs {}",
+            kept(&r.edge_curves),
+            kept(&pieces)
+        );
+    }
 }
 
 #[test]
