@@ -235,7 +235,7 @@ pub struct OptimReport {
     pub sliders: usize,
     /// Quad vertices moved to raise the worst scaled Jacobians ([`OptimOptions::repair`])...
     pub repaired: usize,
-    /// ... of which boundary vertices moved along their curves (counted once a pass).
+    /// ... of which boundary vertices moved along their curves.
     pub repaired_sliders: usize,
     /// Wall-clock seconds.
     pub seconds: f64,

@@ -222,24 +222,22 @@ impl Sliders {
                 continue;
             };
             let mut at = start.0;
-            let better = |f: Option<(f64, f64)>, best: (f64, f64)| {
-                f.is_some_and(|f| f.0 > best.0 || (f.0 == best.0 && f.1 > best.1))
-            };
+            let better =
+                |f: &(f64, f64), best: (f64, f64)| f.0 > best.0 || (f.0 == best.0 && f.1 > best.1);
             for k in 0..=REPAIR_SCAN {
                 let a = lo + (hi - lo) * k as f64 / REPAIR_SCAN as f64;
-                let f = value(a);
-                if better(f, best) {
-                    (at, best) = (a, f.unwrap_or(best));
+                if let Some(f) = value(a).filter(|f| better(f, best)) {
+                    (at, best) = (a, f);
                 }
             }
             let mut step = (hi - lo) / REPAIR_SCAN as f64 / 2.0;
             for _ in 0..REPAIR_HALVINGS {
                 for a in [at - step, at + step] {
-                    if (lo..=hi).contains(&a) {
-                        let f = value(a);
-                        if better(f, best) {
-                            (at, best) = (a, f.unwrap_or(best));
-                        }
+                    if !(lo..=hi).contains(&a) {
+                        continue;
+                    }
+                    if let Some(f) = value(a).filter(|f| better(f, best)) {
+                        (at, best) = (a, f);
                     }
                 }
                 step /= 2.0;
