@@ -116,9 +116,9 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             r.label_agreement
         );
         // A corner between two boundary edges fills a sector alone: its sine bounds the worst
-        // scaled Jacobian; on nine of the ten the worst is either such a corner, where the
+        // scaled Jacobian; on every fixture the worst is either such a corner, where the
         // curves could not be turned wider within the tolerance, or at the repair's bar of 0.5
-        // (coffee's worst lies in a strip a pixel wide).
+        // (coffee's, in a strip a pixel wide, since refinement leaves such strips alone).
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -169,7 +169,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_a_bound >= 8, "{at_a_bound}");
+    assert!(at_a_bound >= 10, "{at_a_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
