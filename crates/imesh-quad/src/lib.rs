@@ -48,7 +48,7 @@ mod template;
 
 pub use adapt::{adapt, adapt_within, AdaptReport, EdgeCurve, LOCAL_ROUNDS, POOR_SCALED_JACOBIAN};
 pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
-pub use dt::{DensityOptions, RegionTriangulation, MAX_TRIANGLE_AREA, NONE};
+pub use dt::{DensityOptions, RegionTriangulation, BOUNDARY_CLEARANCE, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
 pub use pairing::{Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER};
 pub use patch::{basis, ControlNet, TRIANGLE_SLOTS};
