@@ -191,7 +191,7 @@ impl RegionTriangulation {
 pub const MAX_TRIANGLE_AREA: f64 = 1.0;
 
 /// How close to a boundary, in spacings, refinement of a uniform DT' may insert a point
-/// ([`clear_of_boundaries`]). Where a strip is narrower than about twice this, a triangle
+/// (a veto on its candidate points). Where a strip is narrower than about twice this, a triangle
 /// spanning it is skinny, and its circumcentre (or off-centre) falls inside the strip: inserted,
 /// it split the strip into triangles a fraction of its width, hence clusters of quads a tenth
 /// of the mesh's mean area and a shape of 0.28 (coffee, a strip 1.1 px wide at a 3 px spacing).
