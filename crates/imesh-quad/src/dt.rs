@@ -226,7 +226,8 @@ fn clear_of_boundaries(spacing: f64) -> impl FnMut(&Triangulation, &Candidate) -
                     ) < near2
             })
         };
-        shortest2 < near2 || !(near_segment(c.bad) || near_segment(c.containing))
+        shortest2 < near2
+            || !(near_segment(c.bad) || (c.containing != c.bad && near_segment(c.containing)))
     }
 }
 
