@@ -391,20 +391,32 @@ impl QuadMesh {
     /// # Ok::<(), imesh_geom::GeomError>(())
     /// ```
     pub fn is_valid_above(&self, q: usize, floor: f64) -> bool {
-        if floor < SURE_JACOBIAN {
-            let jacobian = self.scaled_jacobian(q);
-            return jacobian >= floor && (jacobian >= SURE_JACOBIAN || self.is_valid(q));
-        }
-        // A positive floor: every corner's sine `α / (|a| |b|)` at least `floor`, squared to
-        // spare the roots and divisions (the same test up to a rounding of the last bit).
-        let p = self.quads[q].map(|v| self.vertices[v as usize]);
-        let floor2 = floor * floor;
-        (0..4).all(|i| {
-            let (a, b) = (p[(i + 1) % 4] - p[i], p[(i + 3) % 4] - p[i]);
-            let cross = a.x * b.y - a.y * b.x;
-            cross > 0.0
-                && cross * cross >= floor2 * ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y))
-        })
+        valid_above(&self.quads[q].map(|v| self.vertices[v as usize]), floor)
+    }
+
+    /// Whether every quad of element `index` would pass [`QuadMesh::is_valid_above`] at its
+    /// floor (`floors[x]` for quad `x` of the mesh) if the element's patch had the control
+    /// points `patch` (by slot): its template points, those on its sides too, are evaluated
+    /// from `patch` into a scratch buffer; nothing is written.
+    pub(crate) fn element_valid_with(
+        &self,
+        m: &ElementMesh,
+        index: usize,
+        patch: &[Point; 16],
+        floors: &[f64],
+    ) -> bool {
+        let template = &self.templates[usize::from(matches!(m.elements[index], Element::Quad(_)))];
+        let points: Vec<Point> = template
+            .terms
+            .iter()
+            .map(|terms| eval_patch_terms(patch, terms))
+            .collect();
+        let first = self.quad_first[index] as usize;
+        template
+            .quads
+            .iter()
+            .zip(&floors[first..])
+            .all(|(quad, &floor)| valid_above(&quad.map(|i| points[i as usize]), floor))
     }
 
     /// The total (signed) area of the quads.
@@ -545,6 +557,24 @@ fn disjoint_slices<T>(
 /// some 10⁵ times the bound on its rounding error (a few ε times `|aₓ b_y| + |a_y bₓ|`, itself at
 /// most `2 |a| |b|`), so the exact orientation is positive too.
 pub const SURE_JACOBIAN: f64 = 1e-10;
+
+/// [`QuadMesh::is_valid_above`] of the quad with corners `p`.
+fn valid_above(p: &[Point; 4], floor: f64) -> bool {
+    if floor < SURE_JACOBIAN {
+        let jacobian = scaled_jacobian(p);
+        return jacobian >= floor
+            && (jacobian >= SURE_JACOBIAN
+                || (0..4).all(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) > 0.0));
+    }
+    // A positive floor: every corner's sine `α / (|a| |b|)` at least `floor`, squared to
+    // spare the roots and divisions (the same test up to a rounding of the last bit).
+    let floor2 = floor * floor;
+    (0..4).all(|i| {
+        let (a, b) = (p[(i + 1) % 4] - p[i], p[(i + 3) % 4] - p[i]);
+        let cross = a.x * b.y - a.y * b.x;
+        cross > 0.0 && cross * cross >= floor2 * ((a.x * a.x + a.y * a.y) * (b.x * b.x + b.y * b.y))
+    })
+}
 
 /// The scaled Jacobian of the quad `p`: the least sine of its corner angles, signed (Verdict's
 /// definition for a counter-clockwise quad; negative at a reflex corner). 0 for a quad with a

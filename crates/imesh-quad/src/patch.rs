@@ -39,6 +39,15 @@ const QUAD_SIDES: [[usize; 4]; 4] = [
 /// The inner slots of a quad patch.
 const QUAD_INNER: [usize; 4] = [5, 6, 9, 10];
 
+/// The patch slots along side `side` of `element`, from the side's first corner (whose slot
+/// is the first) to the next.
+pub(crate) fn side_slots(element: &Element, side: usize) -> [usize; 4] {
+    match element {
+        Element::Triangle(_) => TRIANGLE_SIDES[side],
+        Element::Quad(_) => QUAD_SIDES[side],
+    }
+}
+
 /// The control net of every patch of M.
 #[derive(Clone, Debug)]
 pub struct ControlNet {
@@ -116,11 +125,7 @@ impl ControlNet {
     /// The four control points along side `side` of element `k`'s patch, from the side's first
     /// corner.
     pub fn side_points(&self, element: &Element, k: usize, side: usize) -> [Point; 4] {
-        let along = match element {
-            Element::Triangle(_) => TRIANGLE_SIDES[side],
-            Element::Quad(_) => QUAD_SIDES[side],
-        };
-        along.map(|slot| self.points[self.patches[k][slot] as usize])
+        side_slots(element, side).map(|slot| self.points[self.patches[k][slot] as usize])
     }
 
     /// The control points apart: those on the elements' sides (corners and edge points), all

@@ -761,3 +761,104 @@ fn the_matching_keeps_every_lattice_square() {
         assert_eq!(squares, cells, "{name}: lattice squares undone");
     }
 }
+
+/// A poor element's curve is damped by the fewest halvings of its share that keep every quad
+/// above the poor bar, found at once: here one G' edge (the bottom of a square region) bulges
+/// into the elements below it, by a quarter to one and a quarter of the square's side, and the
+/// share adaptation keeps is the largest of 1, ½, ¼, ⅛, 1/16, 0 at which the mesh passes,
+/// found by trying each.
+#[test]
+fn damping_keeps_the_largest_share_that_passes() {
+    use imesh_curves::{CubicBezier, GraphEdge};
+    let (a, b) = (Point::new(4.0, 4.0), Point::new(8.0, 4.0));
+    let mut shares = Vec::new();
+    for depth in [0.5, 2.0, 3.5, 5.0] {
+        let mut points = vec![(0.0, 0.0), (12.0, 0.0), (12.0, 12.0), (0.0, 12.0)];
+        points.extend([(4.0, 4.0), (8.0, 4.0), (8.0, 8.0), (4.0, 8.0)]);
+        let points: Vec<Point> = points.into_iter().map(Point::from).collect();
+        let mut edges: Vec<GraphEdge> = (0..4u32)
+            .map(|i| GraphEdge {
+                ends: [i, (i + 1) % 4],
+                labels: [0, u32::MAX],
+            })
+            .collect();
+        edges.extend((0..4u32).map(|i| GraphEdge {
+            ends: [4 + i, 4 + (i + 1) % 4],
+            labels: [1, 0],
+        }));
+        let mut g = CurveGraph::new(points.clone(), edges).unwrap();
+        g.pin_domain_corners(12.0, 12.0);
+        let bottom = g.edges().iter().position(|e| e.ends == [4, 5]).unwrap() as u32;
+        let curves: Vec<CubicBezier> = g
+            .edges()
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                let [p, q] = e.ends.map(|v| points[v as usize]);
+                if k as u32 == bottom {
+                    let down = Point::new(0.0, -depth);
+                    CubicBezier::new([
+                        a,
+                        a + (b - a) * (1.0 / 3.0) + down,
+                        a + (b - a) * (2.0 / 3.0) + down,
+                        b,
+                    ])
+                } else {
+                    CubicBezier::segment(p, q)
+                }
+            })
+            .collect();
+        let r = remesh(&g, &curves, &QuadOptions::default()).unwrap();
+        let t = &r.dt.triangulation;
+        let pieces: Vec<_> = r
+            .edge_curves
+            .iter()
+            .filter(|ec| ec.graph_edge == bottom)
+            .collect();
+        assert_eq!(
+            pieces.len(),
+            1,
+            "depth {depth}: the bottom edge is one M edge"
+        );
+        let kept = pieces[0].weights;
+        assert_eq!(kept[0], kept[1], "depth {depth}: both ends halved alike");
+        // Each share in turn, on the straight templates: the piece placed, the two elements
+        // beside it relaxed and evaluated.
+        let passes = |share: f64| {
+            let mut net = ControlNet::straight(t, &r.elements);
+            let mut mesh = QuadMesh::build(t, &r.elements, &net, 1);
+            let straight = mesh.clone();
+            let ec = imesh_quad::EdgeCurve {
+                weights: [share; 2],
+                ..*pieces[0]
+            };
+            let control = ec.path().control;
+            let [i, j] = net.edge_inner(ec.edge);
+            net.points[i as usize] = control[1];
+            net.points[j as usize] = control[2];
+            let h = r.elements.edges[ec.edge as usize];
+            for f in [t.triangle_of(h), t.triangle_of(t.twin(h))] {
+                let element = r.elements.element_of_triangle[f.index()] as usize;
+                net.relax_inner(&r.elements.elements[element], element);
+                mesh.evaluate_element(&r.elements, &net, element);
+            }
+            (0..mesh.quads.len()).all(|x| {
+                mesh.is_valid_above(
+                    x,
+                    POOR_SCALED_JACOBIAN.min(straight.scaled_jacobian(x)) - 1e-9,
+                )
+            })
+        };
+        let expected = [1.0, 0.5, 0.25, 0.125, 0.0625, 0.0]
+            .into_iter()
+            .find(|&s| passes(s))
+            .unwrap();
+        assert_eq!(kept[0], expected, "depth {depth}");
+        assert_eq!(r.adaptation.invalid_left, 0);
+        shares.push(expected);
+    }
+    // From a bulge kept whole to one damped three times: each deeper one needs more.
+    assert_eq!(shares[0], 1.0);
+    assert!(shares.windows(2).all(|w| w[1] < w[0]), "{shares:?}");
+    assert!(shares[3] <= 0.125, "{shares:?}");
+}
