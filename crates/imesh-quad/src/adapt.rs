@@ -440,6 +440,18 @@ fn halved_times(w: f64, times: u32) -> f64 {
 /// Most halvings before any share is none (1 → ½ → ¼ → ⅛ → 1/16 → 0).
 const MAX_HALVINGS: u32 = 5;
 
+/// Asks `halvings` of a share for this round (its last round `stamp`, the halvings asked of it
+/// `asked`: the most any element asks); true the first time this round.
+fn ask(stamp: &mut u32, asked: &mut u32, round: u32, halvings: u32) -> bool {
+    let first = std::mem::replace(stamp, round) != round;
+    *asked = if first {
+        halvings
+    } else {
+        (*asked).max(halvings)
+    };
+    first
+}
+
 /// Where the curves are: per M edge, its adapted piece (an index into the pieces), and per
 /// DT' vertex, the G' edge it is a Steiner vertex of ([`NONE`] for neither).
 #[derive(Clone, Copy)]
@@ -568,12 +580,12 @@ impl Damping {
                 for (corner, &v) in element.corners().iter().enumerate() {
                     let piece = self.pieces_at[v as usize][0];
                     if lookup.curve_of_vertex[v as usize] != NONE && piece != NONE {
-                        // The vertex between the chord and the curve, as `blend` puts it.
-                        let ec = &adapted[piece as usize];
+                        // The vertex between the chord and the curve, where a piece there
+                        // puts it.
+                        let mut ec = adapted[piece as usize];
                         let end = usize::from(self.ends[piece as usize][0] != v);
-                        let (chord, curve) = (ec.chord[end], ec.curve.control[3 * end]);
-                        patch[side_slots(element, corner)[0]] =
-                            chord + (curve - chord) * share(v, times);
+                        ec.weights[end] = share(v, times);
+                        patch[side_slots(element, corner)[0]] = blend(&ec)[3 * end];
                     }
                 }
                 for side in 0..m.side_count(index) {
@@ -650,14 +662,15 @@ impl Damping {
                 let v = self.ends[p as usize][end];
                 if curve_of_vertex[v as usize] != NONE {
                     self.damp_vertex(v, curve_of_vertex[v as usize], round, halvings);
-                } else if adapted[p as usize].weights[end] > 0.0 {
-                    let asked = &mut self.end_halvings[p as usize][end];
-                    if std::mem::replace(&mut self.end_round[p as usize][end], round) != round {
-                        self.graph_ends.push((p, end));
-                        *asked = halvings;
-                    } else {
-                        *asked = (*asked).max(halvings);
-                    }
+                } else if adapted[p as usize].weights[end] > 0.0
+                    && ask(
+                        &mut self.end_round[p as usize][end],
+                        &mut self.end_halvings[p as usize][end],
+                        round,
+                        halvings,
+                    )
+                {
+                    self.graph_ends.push((p, end));
                 }
             }
         }
@@ -670,15 +683,16 @@ impl Damping {
     /// (by the most halvings asked).
     fn damp_vertex(&mut self, v: u32, k: u32, round: u32, halvings: u32) {
         let v = v as usize;
-        if self.at_vertex[v] <= 0.0 {
-            return;
-        }
-        if std::mem::replace(&mut self.vertex_round[v], round) != round {
+        if self.at_vertex[v] > 0.0
+            && ask(
+                &mut self.vertex_round[v],
+                &mut self.vertex_halvings[v],
+                round,
+                halvings,
+            )
+        {
             self.vertices.push(v as u32);
             self.smoothed.push(k);
-            self.vertex_halvings[v] = halvings;
-        } else {
-            self.vertex_halvings[v] = self.vertex_halvings[v].max(halvings);
         }
     }
 
