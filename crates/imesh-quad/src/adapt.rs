@@ -580,49 +580,57 @@ impl Damping {
         let element = &m.elements[index];
         let start = net.patch_points(index);
         let share = |v: u32, times: u32| halved_times(self.at_vertex[v as usize], times);
-        (1..MAX_HALVINGS)
-            .find(|&times| {
-                let mut patch = start;
-                for (corner, &v) in element.corners().iter().enumerate() {
-                    let piece = self.pieces_at[v as usize][0];
-                    if lookup.curve_of_vertex[v as usize] != NONE && piece != NONE {
-                        // The vertex between the chord and the curve, where a piece there
-                        // puts it.
-                        let mut ec = adapted[piece as usize];
-                        let end = usize::from(self.ends[piece as usize][0] != v);
-                        ec.weights[end] = share(v, times);
-                        patch[side_slots(element, corner)[0]] = blend(&ec)[3 * end];
-                    }
-                }
-                for side in 0..m.side_count(index) {
-                    let (e, forward) = m.side_edge(index, side);
-                    let piece = lookup.curve_of_edge[e as usize];
-                    if piece == NONE {
-                        continue;
-                    }
+        for times in 1..MAX_HALVINGS {
+            // Once every share is none, a further halving gives the same patch.
+            let mut bulging = false;
+            let mut patch = start;
+            for (corner, &v) in element.corners().iter().enumerate() {
+                let piece = self.pieces_at[v as usize][0];
+                if lookup.curve_of_vertex[v as usize] != NONE && piece != NONE {
+                    // The vertex between the chord and the curve, where a piece there
+                    // puts it.
                     let mut ec = adapted[piece as usize];
-                    for (end, &v) in self.ends[piece as usize].iter().enumerate() {
-                        ec.weights[end] = if lookup.curve_of_vertex[v as usize] != NONE {
-                            share(v, times)
-                        } else {
-                            halved_times(ec.weights[end], times)
-                        };
-                    }
-                    let mut points = blend(&ec);
-                    if !forward {
-                        points.reverse();
-                    }
-                    for (slot, p) in side_slots(element, side).into_iter().zip(points) {
-                        patch[slot] = p;
-                    }
+                    let end = usize::from(self.ends[piece as usize][0] != v);
+                    ec.weights[end] = share(v, times);
+                    bulging |= ec.weights[end] > 0.0;
+                    patch[side_slots(element, corner)[0]] = blend(&ec)[3 * end];
                 }
-                let (inner, count) = relaxed_inner(element, &patch);
-                for &(slot, p) in &inner[..count] {
+            }
+            for side in 0..m.side_count(index) {
+                let (e, forward) = m.side_edge(index, side);
+                let piece = lookup.curve_of_edge[e as usize];
+                if piece == NONE {
+                    continue;
+                }
+                let mut ec = adapted[piece as usize];
+                for (end, &v) in self.ends[piece as usize].iter().enumerate() {
+                    ec.weights[end] = if lookup.curve_of_vertex[v as usize] != NONE {
+                        share(v, times)
+                    } else {
+                        halved_times(ec.weights[end], times)
+                    };
+                    bulging |= ec.weights[end] > 0.0;
+                }
+                let mut points = blend(&ec);
+                if !forward {
+                    points.reverse();
+                }
+                for (slot, p) in side_slots(element, side).into_iter().zip(points) {
                     patch[slot] = p;
                 }
-                q.element_valid_with(m, index, &patch, bar)
-            })
-            .unwrap_or(MAX_HALVINGS)
+            }
+            let (inner, count) = relaxed_inner(element, &patch);
+            for &(slot, p) in &inner[..count] {
+                patch[slot] = p;
+            }
+            if q.element_valid_with(index, &patch, bar) {
+                return times;
+            }
+            if !bulging {
+                break;
+            }
+        }
+        MAX_HALVINGS
     }
 
     /// Lists for this round what shapes element `index` (the ends of its curved sides, its

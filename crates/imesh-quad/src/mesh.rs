@@ -1,9 +1,9 @@
 //! The quad mesh Q: template quads of every element of M, with provenance (DESIGN.md §2,
 //! step 8).
 
-use imesh_geom::predicates::orient2d;
 use std::sync::OnceLock;
 
+use imesh_geom::predicates::orient2d;
 use imesh_geom::{Point, Triangulation};
 
 use crate::pairing::{Element, ElementMesh};
@@ -178,9 +178,7 @@ impl QuadMesh {
             self.points.len()
         ];
         for index in 0..self.point_first.len() - 1 {
-            // The template by its quad count: 3k² for a triangle, 4k² for a quad.
-            let quads = self.element_quads(index).len();
-            let template = &self.templates[usize::from(quads == self.templates[1].quads.len())];
+            let template = self.template_of(index);
             for (&v, &coords) in self.element_vertices(index).iter().zip(&template.coords) {
                 holders[fill[v as usize] as usize] = Holder {
                     element: index as u32,
@@ -190,6 +188,13 @@ impl QuadMesh {
             }
         }
         Holders { first, holders }
+    }
+
+    /// The template of element `index`, known by its quad count: 3k² for a triangle of M,
+    /// 4k² for a quad.
+    fn template_of(&self, index: usize) -> &Template {
+        let quads = self.element_quads(index).len();
+        &self.templates[usize::from(quads == self.templates[1].quads.len())]
     }
 
     /// The vertices of element `index`'s template points, in template order.
@@ -416,12 +421,11 @@ impl QuadMesh {
     /// from `patch` into a scratch buffer; nothing is written.
     pub(crate) fn element_valid_with(
         &self,
-        m: &ElementMesh,
         index: usize,
         patch: &[Point; 16],
         floors: &[f64],
     ) -> bool {
-        let template = &self.templates[usize::from(matches!(m.elements[index], Element::Quad(_)))];
+        let template = self.template_of(index);
         let points: Vec<Point> = template
             .terms
             .iter()
