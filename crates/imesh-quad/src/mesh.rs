@@ -579,7 +579,7 @@ fn disjoint_slices<T>(
 pub const SURE_JACOBIAN: f64 = 1e-10;
 
 /// [`QuadMesh::is_valid_above`] of the quad with corners `p`.
-fn valid_above(p: &[Point; 4], floor: f64) -> bool {
+pub(crate) fn valid_above(p: &[Point; 4], floor: f64) -> bool {
     if floor < SURE_JACOBIAN {
         let jacobian = scaled_jacobian(p);
         return jacobian >= floor
