@@ -614,9 +614,12 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             );
         }
         println!("{line}");
-        // A worst corner the boundaries force: say so, and where.
+        // A worst corner the boundaries force: say so, and where. Only a corner sharper than a
+        // quad's should be (30°) is forced: a wider one is the mesh's own choice.
         if let Some(corner) = report.sharpest_boundary_corner {
-            if q.scaled_jacobian().min >= corner.scaled_jacobian - 1e-9 {
+            if corner.angle_deg < imesh_curves::MIN_CORNER_DEG
+                && q.scaled_jacobian().min >= corner.scaled_jacobian - 1e-9
+            {
                 println!(
                     "the worst scaled Jacobian is a corner of {:.1}° between two boundaries at ({:.1}, {:.1}) px, which the quad there must keep (sharp in the image, and not widened within the curve tolerance)",
                     corner.angle_deg, corner.at[0], corner.at[1]

@@ -813,3 +813,48 @@ fn the_svg_can_be_drawn_over_the_input_image() {
     let plain = std::fs::read_to_string(dir.path().join("m.svg")).unwrap();
     assert!(!plain.contains("<image") && plain.contains("fill-opacity=\"1\""));
 }
+
+/// The note on a forced worst corner appears only for a corner sharper than 30°: MRI's spike tip
+/// (27.0°), not a square region's right angles.
+#[test]
+fn the_forced_corner_note_names_only_sharp_corners() {
+    let dir = tempfile::tempdir().unwrap();
+    let note = "between two boundaries";
+    let out = imesh(
+        &[
+            "mesh",
+            fixture("matplotlib-s1045_mri.png").to_str().unwrap(),
+            "-o",
+            "mri.msh",
+        ],
+        dir.path(),
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains(&format!("a corner of 27.0° {note}")),
+        "{said}"
+    );
+    // A square of one label in another: the image's corners and the square's are right angles,
+    // and a one-pixel image's four corners too.
+    let mut square = image::GrayImage::new(24, 24);
+    for (x, y, p) in square.enumerate_pixels_mut() {
+        p.0 = [if (8..16).contains(&x) && (8..16).contains(&y) {
+            255
+        } else {
+            0
+        }];
+    }
+    square.save(dir.path().join("square.png")).unwrap();
+    image::GrayImage::new(1, 1)
+        .save(dir.path().join("one.png"))
+        .unwrap();
+    for name in ["square.png", "one.png"] {
+        let out = imesh(&["mesh", name, "-o", "out.msh"], dir.path());
+        assert!(out.status.success());
+        let said = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            said.contains("scaled Jacobian worst") && !said.contains(note),
+            "{said}"
+        );
+    }
+}
