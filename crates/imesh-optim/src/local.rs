@@ -240,8 +240,19 @@ pub(crate) fn descend(
 ) -> usize {
     let mut energy = total_energy(vertices);
     let mut sweeps = 0;
-    // Only points whose quads changed since they were last solved are solved again.
-    let mut dirty = vec![true; variables.len()];
+    // Only points whose quads changed since they were last solved are solved again: each quad
+    // carries the step it last moved at, each point the step it was last solved at (all
+    // quads moved before any solve).
+    let mut moved_at = vec![1u32; setup.quads.len()];
+    let mut solved_at = vec![0u32; variables.len()];
+    let changed = |i: usize, moved_at: &[u32], solved_at: &[u32]| {
+        variables
+            .quads
+            .row(i)
+            .iter()
+            .any(|&q| moved_at[q as usize] > solved_at[i])
+    };
+    let mut step = 1u32;
     let still = 1e-3 * setup.average_area.sqrt();
     while sweeps < setup.max_sweeps {
         sweeps += 1;
@@ -249,9 +260,10 @@ pub(crate) fn descend(
             let moves: Vec<(usize, Point)> = {
                 let (vertices, net_view): (&[Point], &[Point]) =
                     (vertices, net.as_deref().unwrap_or(&[]));
+                let (moved_at, solved_at) = (&moved_at[..], &solved_at[..]);
                 colour
                     .par_iter()
-                    .filter(|&&i| dirty[i as usize])
+                    .filter(|&&i| changed(i as usize, moved_at, solved_at))
                     .map_init(Scratch::default, |scratch, &i| {
                         let i = i as usize;
                         let id = variables.ids[i] as usize;
@@ -266,15 +278,16 @@ pub(crate) fn descend(
                     .flatten()
                     .collect()
             };
+            // Solved at this step; what the moves change, at the next (their own points
+            // included: a point that moved is solved again).
+            step += 2;
             for &i in colour {
-                dirty[i as usize] = false;
+                solved_at[i as usize] = step - 1;
             }
             for (i, delta) in moves {
                 if delta.x.abs().max(delta.y.abs()) > still {
                     for &q in variables.quads.row(i) {
-                        for &j in variables.by_quad.row(q as usize) {
-                            dirty[j as usize] = true;
-                        }
+                        moved_at[q as usize] = step;
                     }
                 }
                 for &(v, w) in variables.influence.row(i) {
@@ -289,7 +302,10 @@ pub(crate) fn descend(
         let next = total_energy(vertices);
         let drop = energy - next;
         energy = next;
-        if drop <= setup.tolerance * energy.max(f64::MIN_POSITIVE) || !dirty.contains(&true) {
+        let any_changed = (0..variables.len())
+            .into_par_iter()
+            .any(|i| changed(i, &moved_at, &solved_at));
+        if drop <= setup.tolerance * energy.max(f64::MIN_POSITIVE) || !any_changed {
             break;
         }
     }
