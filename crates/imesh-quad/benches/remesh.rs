@@ -3,8 +3,8 @@
 //! 512 × 512, Otsu: thousands of blades; 50 282 triangles, the paper's graded DT').
 //!
 //! `cargo bench -p imesh-quad`. Goal (issue 7): pairing + templates + adaptation in < 50 ms for
-//! 10^5 triangles, so < 25 ms here; the last group is the same boundaries refined to about
-//! 10^5 triangles.
+//! 10^5 triangles, so < 25 ms here; the next group is the same boundaries refined to about
+//! 10^5 triangles, the last a label image's (stardist's nuclei) refined to about 10^5.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -107,7 +107,32 @@ fn bench(c: &mut Criterion) {
         |b| b.iter(|| black_box(quad_stage(&fine, &s.graph, &curves))),
     );
     group.finish();
+
+    // A label image (stardist's nuclei: 123 round regions) at the issue's size: how the stage
+    // does where the boundaries are smooth, against grass's thousands of ragged blades.
+    let grid = support::fixture("stardist-mask2d_labels.png");
+    let (_, s, curves) = support::simplified_with_curves(&grid);
+    let fine = RegionTriangulation::new(
+        &s.graph,
+        &DensityOptions {
+            max_size: Some(STARDIST_MAX_SIZE),
+            ..DensityOptions::default()
+        },
+    )
+    .expect("DT' builds");
+    let triangles = fine.triangulation.num_triangles();
+    let mut group = c.benchmark_group("quad stage stardist");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(triangles as u64));
+    group.bench_function(
+        format!("pair + patches + templates + adaptation, {triangles} triangles"),
+        |b| b.iter(|| black_box(quad_stage(&fine, &s.graph, &curves))),
+    );
+    group.finish();
 }
+
+/// The largest DT' triangle side on the stardist fixture that gives about 10^5 triangles.
+const STARDIST_MAX_SIZE: f64 = 3.05;
 
 /// The measured path: pairing (greedy), straight patches, level-1 templates, adaptation.
 fn quad_stage(
