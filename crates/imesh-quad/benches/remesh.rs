@@ -73,14 +73,7 @@ fn bench(c: &mut Criterion) {
 
     // The issue's own size: the same boundaries refined to no triangle larger than the
     // equilateral one of 3.2 px, about 10^5 triangles.
-    let fine = RegionTriangulation::new(
-        &s.graph,
-        &DensityOptions {
-            max_size: Some(3.2),
-            ..DensityOptions::default()
-        },
-    )
-    .expect("DT' builds");
+    let fine = refined(&s.graph, 3.2);
     let triangles = fine.triangulation.num_triangles();
     {
         let t0 = std::time::Instant::now();
@@ -99,34 +92,46 @@ fn bench(c: &mut Criterion) {
             t0.elapsed() - t2
         );
     }
-    let mut group = c.benchmark_group("quad stage grass, max size 3.2 px");
-    group.sample_size(10);
-    group.throughput(Throughput::Elements(triangles as u64));
-    group.bench_function(
-        format!("pair + patches + templates + adaptation, {triangles} triangles"),
-        |b| b.iter(|| black_box(quad_stage(&fine, &s.graph, &curves))),
+    bench_whole_stage(
+        c,
+        "quad stage grass, max size 3.2 px",
+        &fine,
+        &s.graph,
+        &curves,
     );
-    group.finish();
 
     // A label image (stardist's nuclei: 123 round regions) at the size: how the stage
     // does where the boundaries are smooth, against grass's thousands of ragged blades.
     let grid = support::fixture("stardist-mask2d_labels.png");
     let (_, s, curves) = support::simplified_with_curves(&grid);
-    let fine = RegionTriangulation::new(
-        &s.graph,
-        &DensityOptions {
-            max_size: Some(STARDIST_MAX_SIZE),
-            ..DensityOptions::default()
-        },
-    )
-    .expect("DT' builds");
-    let triangles = fine.triangulation.num_triangles();
-    let mut group = c.benchmark_group("quad stage stardist");
+    let fine = refined(&s.graph, STARDIST_MAX_SIZE);
+    bench_whole_stage(c, "quad stage stardist", &fine, &s.graph, &curves);
+}
+
+/// DT' of `graph` with no triangle larger than the equilateral one of side `max_size` px.
+fn refined(graph: &CurveGraph, max_size: f64) -> RegionTriangulation {
+    let density = DensityOptions {
+        max_size: Some(max_size),
+        ..DensityOptions::default()
+    };
+    RegionTriangulation::new(graph, &density).expect("DT' builds")
+}
+
+/// The criterion group `name` timing [`quad_stage`] on `dt`.
+fn bench_whole_stage(
+    c: &mut Criterion,
+    name: &str,
+    dt: &RegionTriangulation,
+    graph: &CurveGraph,
+    curves: &[CubicBezier],
+) {
+    let triangles = dt.triangulation.num_triangles();
+    let mut group = c.benchmark_group(name);
     group.sample_size(10);
     group.throughput(Throughput::Elements(triangles as u64));
     group.bench_function(
         format!("pair + patches + templates + adaptation, {triangles} triangles"),
-        |b| b.iter(|| black_box(quad_stage(&fine, &s.graph, &curves))),
+        |b| b.iter(|| black_box(quad_stage(dt, graph, curves))),
     );
     group.finish();
 }
