@@ -55,12 +55,16 @@ pub fn venv_python(
             "creating a Python virtual environment (is python3 with venv installed?)",
         )?;
     }
+    // The probe's own error (a Python traceback when the package is missing) says nothing the
+    // line below does not.
     let ready = Command::new(&python)
         .args(["-c", check])
+        .stderr(std::process::Stdio::null())
         .status()
         .map(|s| s.success())
         .unwrap_or(false);
     if !ready {
+        eprintln!("installing {requirement} into {}", venv.display());
         run(
             Command::new(&python).args(["-m", "pip", "install", "--quiet", requirement]),
             &format!("installing {requirement} from PyPI (is PyPI reachable?)"),
