@@ -2,13 +2,16 @@
 //!
 //! `cargo bench -p imesh-classify` (throughput is reported in elements = pixels per second).
 //! Goals on 2 cores: ≥ 50 MP/s for threshold and label map, ≥ 5 MP/s for k-means and texture.
+//! The clean-up group times the majority filter against imageproc's median filter of the same
+//! window (a sliding histogram too, on one grey channel) in the same run.
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use image::{DynamicImage, GrayImage, Luma, Rgb, RgbImage};
 use imesh_classify::{
-    classify, Classifier, ClassifyOptions, SampleLabel, TextureClassifier, TextureSamples,
+    classify, majority_filter, Classifier, ClassifyOptions, LabelGrid, Region, SampleLabel,
+    TextureClassifier, TextureSamples,
 };
 
 const SIDE: u32 = 2048;
@@ -114,5 +117,46 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench);
+/// A label grid of `kinds` labels in 64 × 64 tiles, one pixel in seven a speckle of another.
+fn speckled(kinds: u32) -> LabelGrid {
+    let labels = (0..SIDE * SIDE)
+        .map(|i| {
+            let (x, y) = (i % SIDE, i / SIDE);
+            let tile = (x / 64 + 7 * (y / 64)) % kinds;
+            if noise(x, y) % 7 == 0 {
+                (tile + 1) % kinds
+            } else {
+                tile
+            }
+        })
+        .collect();
+    let regions = (0..kinds)
+        .map(|k| Region {
+            name: k.to_string(),
+            colour: [0, 0, 0],
+        })
+        .collect();
+    LabelGrid::new(SIDE, SIDE, labels, regions).expect("one label per pixel")
+}
+
+/// The pipeline's clean-up at a radius of 4 px (its automatic radius for quads about 4 px wide).
+fn clean_up(c: &mut Criterion) {
+    const RADIUS: u32 = 4;
+    let mut g = c.benchmark_group("cleanup_2048x2048");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(u64::from(SIDE) * u64::from(SIDE)));
+    for kinds in [2, 12, 300] {
+        let grid = speckled(kinds);
+        g.bench_function(format!("majority_filter r={RADIUS}, {kinds} labels"), |b| {
+            b.iter(|| majority_filter(black_box(&grid), RADIUS, 1))
+        });
+    }
+    let grey = GrayImage::from_fn(SIDE, SIDE, |x, y| Luma([noise(x, y)]));
+    g.bench_function(format!("imageproc median_filter r={RADIUS} (peer)"), |b| {
+        b.iter(|| imageproc::filter::median_filter(black_box(&grey), RADIUS, RADIUS))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, clean_up);
 criterion_main!(benches);

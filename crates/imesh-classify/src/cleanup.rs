@@ -163,96 +163,100 @@ pub fn pixel_regions(grid: &LabelGrid) -> Vec<PixelRegion> {
 /// assert_eq!(majority_filter(&g, 1, 1).label(1, 1), 0);
 /// ```
 pub fn majority_filter(grid: &LabelGrid, radius: u32, iterations: u32) -> LabelGrid {
-    let (w, h) = (grid.width() as i64, grid.height() as i64);
-    let r = i64::from(radius);
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let r = radius as usize;
     let mut labels = grid.labels().to_vec();
+    if labels.is_empty() {
+        return grid.clone();
+    }
+    let kinds = labels.iter().max().map_or(0, |&m| m as usize + 1);
     for _ in 0..iterations {
         let src = &labels;
-        let kinds = src.iter().max().map_or(0, |&m| m as usize + 1);
-        let next: Vec<u32> = (0..h)
-            .into_par_iter()
-            .flat_map_iter(|y| {
-                if kinds <= SLIDING_LABELS {
-                    sliding_majority_row(src, w, h, y, r, kinds)
-                } else {
-                    tally_majority_row(src, w, h, y, r)
-                }
-            })
-            .collect();
+        let mut next = vec![0u32; src.len()];
+        // Bands of rows, each worker with one count per label (left at zero after each row).
+        next.par_chunks_mut(w * MAJORITY_BAND_ROWS)
+            .enumerate()
+            .for_each_init(
+                || vec![0u32; kinds],
+                |counts, (band, out)| {
+                    for (k, row) in out.chunks_mut(w).enumerate() {
+                        let y = band * MAJORITY_BAND_ROWS + k;
+                        majority_row(src, [w, h], y, r, counts, row);
+                    }
+                },
+            );
         labels = next;
     }
     grid.with_labels(labels)
 }
 
-/// One row of the majority filter by counting each pixel's whole window: a strictly larger
-/// count replaces the pixel's label, ties to the smaller label.
-fn tally_majority_row(src: &[u32], w: i64, h: i64, y: i64, r: i64) -> Vec<u32> {
-    // (label, count) pairs: a window holds at most (2r+1)² labels, so a linear tally beats
-    // hashing.
-    let mut tally: Vec<(u32, u32)> = Vec::new();
-    (0..w)
-        .map(|x| {
-            tally.clear();
-            for yy in (y - r).max(0)..=(y + r).min(h - 1) {
-                for xx in (x - r).max(0)..=(x + r).min(w - 1) {
-                    let l = src[(yy * w + xx) as usize];
-                    match tally.iter_mut().find(|(t, _)| *t == l) {
-                        Some((_, c)) => *c += 1,
-                        None => tally.push((l, 1)),
-                    }
-                }
-            }
-            let own = src[(y * w + x) as usize];
-            let own_count = tally.iter().find(|(t, _)| *t == own).map_or(0, |&(_, c)| c);
-            // Only a strictly larger count replaces the pixel's own label.
-            tally
-                .iter()
-                .filter(|&&(_, c)| c > own_count)
-                .max_by_key(|&&(l, c)| (c, std::cmp::Reverse(l)))
-                .map_or(own, |&(l, _)| l)
-        })
-        .collect()
-}
+/// Rows per parallel task of [`majority_filter`].
+const MAJORITY_BAND_ROWS: usize = 8;
 
-/// Label maps with at most this many labels are filtered with one count per label, slid along
-/// each row: a step adds one window column and drops another (2 (2r + 1) updates) instead of
-/// counting the whole (2r + 1)² window.
-const SLIDING_LABELS: usize = 32;
-
-/// One row of the majority filter by a sliding count per label (labels below `kinds`): the
-/// same result as [`tally_majority_row`].
-fn sliding_majority_row(src: &[u32], w: i64, h: i64, y: i64, r: i64, kinds: usize) -> Vec<u32> {
-    let (y0, y1) = ((y - r).max(0), (y + r).min(h - 1));
-    let mut counts = vec![0u32; kinds];
-    let column = |counts: &mut [u32], x: i64, add: bool| {
-        if (0..w).contains(&x) {
-            for yy in y0..=y1 {
-                let c = &mut counts[src[(yy * w + x) as usize] as usize];
-                if add {
-                    *c += 1;
-                } else {
-                    *c -= 1;
-                }
+/// Row `y` of the majority filter of radius `r` into `out`: a count per label slides along the
+/// row (a step adds one window column and drops another, 2 (2r + 1) updates), and `counts`
+/// (zero on entry, one slot per label) is zero again on return. A label holding more than half
+/// the window keeps its pixel, as most pixels away from the boundaries do; elsewhere the
+/// labels are compared by their counts (all labels, or the window's pixels when there are
+/// fewer of those): a strictly larger count than the pixel's own replaces it, ties to the
+/// smaller label.
+fn majority_row(
+    src: &[u32],
+    [w, h]: [usize; 2],
+    y: usize,
+    r: usize,
+    counts: &mut [u32],
+    out: &mut [u32],
+) {
+    let (y0, y1) = (y.saturating_sub(r), (y + r).min(h - 1));
+    let column = |counts: &mut [u32], x: usize, add: bool| {
+        for yy in y0..=y1 {
+            let c = &mut counts[src[yy * w + x] as usize];
+            if add {
+                *c += 1;
+            } else {
+                *c -= 1;
             }
         }
     };
     for x in 0..=r.min(w - 1) {
-        column(&mut counts, x, true);
+        column(counts, x, true);
     }
-    let mut row = Vec::with_capacity(w as usize);
     for x in 0..w {
-        let own = src[(y * w + x) as usize];
+        let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
+        let window = (y1 - y0 + 1) * (x1 - x0 + 1);
+        let own = src[y * w + x];
         let (mut best, mut most) = (own, counts[own as usize]);
-        for (l, &c) in counts.iter().enumerate() {
-            if c > most {
-                (best, most) = (l as u32, c);
+        if 2 * most as usize <= window {
+            if counts.len() <= window {
+                for (l, &c) in counts.iter().enumerate() {
+                    if c > most {
+                        (best, most) = (l as u32, c);
+                    }
+                }
+            } else {
+                for yy in y0..=y1 {
+                    for &l in &src[yy * w + x0..=yy * w + x1] {
+                        let c = counts[l as usize];
+                        if c > most || (c == most && best != own && l < best) {
+                            (best, most) = (l, c);
+                        }
+                    }
+                }
             }
         }
-        row.push(best);
-        column(&mut counts, x - r, false);
-        column(&mut counts, x + r + 1, true);
+        out[x] = best;
+        if x >= r {
+            column(counts, x - r, false);
+        }
+        if x + r + 1 < w {
+            column(counts, x + r + 1, true);
+        }
     }
-    row
+    // The last window's columns.
+    for x in w.saturating_sub(r)..w {
+        column(counts, x, false);
+    }
 }
 
 /// A component id (from 0) per pixel: 4-connected pixels of one label share it. (imageproc's
@@ -295,22 +299,50 @@ mod tests {
     use crate::Region;
     use proptest::prelude::*;
 
+    /// One row of the majority filter by counting each pixel's whole window: the definition
+    /// [`majority_row`] is checked against.
+    fn tally_majority_row(src: &[u32], w: usize, h: usize, y: usize, r: usize) -> Vec<u32> {
+        (0..w)
+            .map(|x| {
+                let mut tally: Vec<(u32, u32)> = Vec::new();
+                for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+                    for xx in x.saturating_sub(r)..=(x + r).min(w - 1) {
+                        let l = src[yy * w + xx];
+                        match tally.iter_mut().find(|(t, _)| *t == l) {
+                            Some((_, c)) => *c += 1,
+                            None => tally.push((l, 1)),
+                        }
+                    }
+                }
+                let own = src[y * w + x];
+                let own_count = tally.iter().find(|(t, _)| *t == own).map_or(0, |&(_, c)| c);
+                tally
+                    .iter()
+                    .filter(|&&(_, c)| c > own_count)
+                    .max_by_key(|&&(l, c)| (c, std::cmp::Reverse(l)))
+                    .map_or(own, |&(l, _)| l)
+            })
+            .collect()
+    }
+
     proptest! {
         /// The sliding count gives the whole-window tally's labels, at every radius and on
-        /// every edge of the image.
+        /// every edge of the image, with fewer labels than a window holds and with more (the
+        /// two ways of comparing counts), and leaves its counts at zero.
         #[test]
         fn the_sliding_majority_is_the_window_majority(
-            (w, h, kinds, src) in (1i64..24, 1i64..24, 1u32..6).prop_flat_map(|(w, h, kinds)| {
-                let pixels = prop::collection::vec(0..kinds, (w * h) as usize);
+            (w, h, kinds, src) in (1usize..24, 1usize..24, 1u32..40).prop_flat_map(|(w, h, kinds)| {
+                let pixels = prop::collection::vec(0..kinds, w * h);
                 (Just(w), Just(h), Just(kinds), pixels)
             }),
-            r in 0i64..7,
+            r in 0usize..7,
         ) {
+            let mut counts = vec![0u32; kinds as usize];
+            let mut row = vec![0u32; w];
             for y in 0..h {
-                prop_assert_eq!(
-                    sliding_majority_row(&src, w, h, y, r, kinds as usize),
-                    tally_majority_row(&src, w, h, y, r)
-                );
+                majority_row(&src, [w, h], y, r, &mut counts, &mut row);
+                prop_assert_eq!(&row, &tally_majority_row(&src, w, h, y, r));
+                prop_assert!(counts.iter().all(|&c| c == 0));
             }
         }
     }

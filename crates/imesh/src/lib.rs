@@ -39,6 +39,7 @@ use imesh_segment::{
     c_edges, merge_regions, merge_thin_regions, partition, sample, CEdge, MergeReport,
     SampleOptions, SegmentedMesh, OUTSIDE,
 };
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Which elements to produce.
@@ -1587,16 +1588,7 @@ impl Pipeline {
         if o.min_region > 1 {
             cleaned = imesh_classify::remove_small_regions(&cleaned, o.min_region);
         }
-        // Labels are renumbered when regions vanish: compare by region name.
-        fn name(g: &LabelGrid, l: u32) -> Option<&str> {
-            g.regions().get(l as usize).map(|r| r.name.as_str())
-        }
-        let changed = grid
-            .labels()
-            .iter()
-            .zip(cleaned.labels())
-            .filter(|&(&a, &b)| name(grid, a) != name(&cleaned, b))
-            .count();
+        let changed = relabelled_pixels(grid, &cleaned);
         Some((cleaned, changed))
     }
 
@@ -1731,6 +1723,30 @@ impl MeshOptions {
 
 /// Vertices, elements and labels of a mesh.
 type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
+
+/// How many pixels of `cleaned` have a region other than in `grid`. Labels are renumbered
+/// when regions vanish, so regions are compared by name (each name given one number first,
+/// rather than comparing strings per pixel).
+fn relabelled_pixels(grid: &LabelGrid, cleaned: &LabelGrid) -> usize {
+    let mut numbers = std::collections::HashMap::new();
+    let mut number = |g: &LabelGrid| -> Vec<usize> {
+        g.regions()
+            .iter()
+            .map(|r| {
+                let next = numbers.len();
+                *numbers.entry(r.name.clone()).or_insert(next)
+            })
+            .collect()
+    };
+    let (before, after) = (number(grid), number(cleaned));
+    // A label without a region (none in a valid grid) has no name, as `usize::MAX`.
+    let name = |names: &[usize], l: u32| names.get(l as usize).copied().unwrap_or(usize::MAX);
+    grid.labels()
+        .par_iter()
+        .zip(cleaned.labels())
+        .filter(|&(&a, &b)| name(&before, a) != name(&after, b))
+        .count()
+}
 
 /// The radius of the majority filter that `--majority auto` applies before a uniform mesh of
 /// quad side `quad_size`: about one quad, so that notches, specks and strips the quads could
