@@ -3,6 +3,7 @@
 //! no smoothing that keeps the boundaries can change its angle, and its sine bounds the mesh's
 //! worst scaled Jacobian.
 
+use rayon::slice::ParallelSliceMut;
 use serde::Serialize;
 
 use crate::Point2;
@@ -36,30 +37,36 @@ pub fn sharpest_boundary_corner(
     quads: &[[u32; 4]],
     labels: &[u32],
 ) -> Option<BoundaryCorner> {
-    // Every quad side as (smaller end, larger end, label), sorted so that an edge's sides are
-    // neighbours: it is a boundary edge when it has one, or two of different labels.
-    let mut sides: Vec<(u32, u32, u32)> = quads
+    // Every quad side as (smaller end << 32 | larger end, label, side 4q + k), sorted so that
+    // an edge's sides are neighbours: it is a boundary edge when it has one, or two of
+    // different labels, and each side is marked so.
+    let mut sides: Vec<(u64, u32, u32)> = quads
         .iter()
         .zip(labels)
-        .flat_map(|(q, &label)| {
+        .enumerate()
+        .flat_map(|(i, (q, &label))| {
             (0..4).map(move |k| {
                 let (a, b) = (q[k], q[(k + 1) % 4]);
-                (a.min(b), a.max(b), label)
+                let edge = u64::from(a.min(b)) << 32 | u64::from(a.max(b));
+                (edge, label, (4 * i + k) as u32)
             })
         })
         .collect();
-    sides.sort_unstable();
-    let boundary: std::collections::HashSet<(u32, u32)> = sides
-        .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
-        .filter(|edge| edge.len() == 1 || edge.iter().any(|s| s.2 != edge[0].2))
-        .map(|edge| (edge[0].0, edge[0].1))
-        .collect();
-    let on_boundary = |a: u32, b: u32| boundary.contains(&(a.min(b), a.max(b)));
+    sides.par_sort_unstable_by_key(|s| s.0);
+    let mut boundary = vec![false; 4 * quads.len()];
+    for edge in sides.chunk_by(|x, y| x.0 == y.0) {
+        if edge.len() == 1 || edge.iter().any(|s| s.1 != edge[0].1) {
+            for s in edge {
+                boundary[s.2 as usize] = true;
+            }
+        }
+    }
     let mut sharpest: Option<BoundaryCorner> = None;
-    for q in quads {
+    for (i, q) in quads.iter().enumerate() {
         for k in 0..4 {
             let (prev, v, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
-            if !(on_boundary(prev, v) && on_boundary(v, next)) {
+            // Side k runs v → next, side k − 1 prev → v.
+            if !(boundary[4 * i + (k + 3) % 4] && boundary[4 * i + k]) {
                 continue;
             }
             let (p, c, n) = (

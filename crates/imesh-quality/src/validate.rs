@@ -3,6 +3,7 @@
 
 use std::fmt;
 
+use rayon::slice::ParallelSliceMut;
 use serde::Serialize;
 
 use crate::Point2;
@@ -253,8 +254,8 @@ pub fn validate(mesh: &MeshView<'_>, domain: &Domain) -> ValidationReport {
     check_vertices(mesh, domain, &mut report);
 
     let mut used = vec![false; nv];
-    // (low, high, element traverses low → high)
-    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(4 * mesh.elements.len());
+    // (low end << 32 | high end, element traverses low → high)
+    let mut edges: Vec<(u64, bool)> = Vec::with_capacity(4 * mesh.elements.len());
     for (e, element) in mesh.elements.iter().enumerate() {
         let c = element.corners();
         if let Some(&v) = c.iter().find(|&&v| v as usize >= nv) {
@@ -279,9 +280,13 @@ pub fn validate(mesh: &MeshView<'_>, domain: &Domain) -> ValidationReport {
                 });
             }
             let (a, b) = (c[k], c[(k + 1) % n]);
-            edges.push((a.min(b), a.max(b), a < b));
+            edges.push((u64::from(a.min(b)) << 32 | u64::from(a.max(b)), a < b));
         }
-        report.area += signed_area(&(0..n).map(p).collect::<Vec<_>>());
+        let mut polygon = [[0.0; 2]; 4];
+        for (k, corner) in polygon.iter_mut().enumerate().take(n) {
+            *corner = p(k);
+        }
+        report.area += signed_area(&polygon[..n]);
     }
     for (v, _) in used.iter().enumerate().filter(|(_, u)| !**u) {
         report.push(Violation::UnusedVertex { vertex: v as u32 });
@@ -313,7 +318,7 @@ fn check_vertices(mesh: &MeshView<'_>, domain: &Domain, report: &mut ValidationR
         let p = mesh.vertices[v as usize];
         ((p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits())
     };
-    order.sort_unstable_by_key(|&v| (key(v), v));
+    order.par_sort_unstable_by_key(|&v| (key(v), v));
     for w in order.windows(2) {
         if key(w[0]) == key(w[1]) {
             report.push(Violation::DuplicateVertex {
@@ -327,12 +332,12 @@ fn check_vertices(mesh: &MeshView<'_>, domain: &Domain, report: &mut ValidationR
 fn check_edges(
     mesh: &MeshView<'_>,
     domain: &Domain,
-    mut edges: Vec<(u32, u32, bool)>,
+    mut edges: Vec<(u64, bool)>,
     report: &mut ValidationReport,
 ) {
-    edges.sort_unstable();
-    for edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-        let (a, b, _) = edge[0];
+    edges.par_sort_unstable_by_key(|e| e.0);
+    for edge in edges.chunk_by(|x, y| x.0 == y.0) {
+        let (a, b) = ((edge[0].0 >> 32) as u32, edge[0].0 as u32);
         match edge.len() {
             1 => {
                 if !domain.on_border(mesh.vertices[a as usize], mesh.vertices[b as usize]) {
@@ -340,7 +345,7 @@ fn check_edges(
                 }
             }
             2 => {
-                if edge[0].2 == edge[1].2 {
+                if edge[0].1 == edge[1].1 {
                     report.push(Violation::EdgeSameDirection { a, b });
                 }
             }

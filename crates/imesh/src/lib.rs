@@ -19,6 +19,7 @@
 
 use std::path::Path;
 use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -2044,15 +2045,16 @@ fn agreement_with_original(mesh: &SegmentedMeshData, original: &LabelGrid) -> f6
         .enumerate()
         .map(|(i, r)| (r.name.as_str(), i as u32))
         .collect();
+    // Looked up once per label, not per element.
+    let original_label: Vec<u32> = mesh
+        .label_names
+        .iter()
+        .map(|name| id.get(name.as_str()).copied().unwrap_or(u32::MAX))
+        .collect();
     let labels: Vec<u32> = mesh
         .labels
         .iter()
-        .map(|&l| {
-            mesh.label_names
-                .get(l as usize)
-                .and_then(|name| id.get(name.as_str()).copied())
-                .unwrap_or(u32::MAX)
-        })
+        .map(|&l| original_label.get(l as usize).copied().unwrap_or(u32::MAX))
         .collect();
     agreement(&mesh.vertices, &mesh.elements, &labels, original)
 }
@@ -2063,43 +2065,52 @@ fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: 
     if w == 0 || h == 0 {
         return 1.0;
     }
-    let mut agrees = vec![false; w * h];
-    for (element, &label) in elements.iter().zip(labels) {
-        let corners: Vec<[f64; 2]> = element
-            .corners()
-            .iter()
-            .map(|&v| vertices[v as usize])
-            .collect();
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for c in &corners {
-            for k in 0..2 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
+    // Each element marks its pixel centres of its own label, element by element in parallel
+    // (a centre on an edge shared by two elements may be marked twice).
+    let agrees: Vec<AtomicBool> = (0..w * h).map(|_| AtomicBool::new(false)).collect();
+    elements
+        .par_iter()
+        .zip(labels)
+        .for_each(|(element, &label)| {
+            let ids = element.corners();
+            let n = ids.len();
+            let mut corners = [[0.0; 2]; 4];
+            for (c, &v) in corners.iter_mut().zip(ids) {
+                *c = vertices[v as usize];
             }
-        }
-        // Pixel centres (col + 0.5, row + 0.5) inside the bounding box.
-        let first = |x: f64| (x - 0.5).ceil().max(0.0) as usize;
-        let last = |x: f64, n: usize| ((x - 0.5).floor().min(n as f64 - 1.0)).max(-1.0);
-        let (c0, r0) = (first(lo[0]), first(lo[1]));
-        let (c1, r1) = (last(hi[0], w), last(hi[1], h));
-        if c1 < 0.0 || r1 < 0.0 {
-            continue;
-        }
-        for row in r0..=r1 as usize {
-            for col in c0..=c1 as usize {
-                let p = [col as f64 + 0.5, row as f64 + 0.5];
-                let n = corners.len();
-                let inside = (0..n).all(|i| {
-                    let (a, b) = (corners[i], corners[(i + 1) % n]);
-                    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0.0
-                });
-                if inside && grid.label(col as u32, row as u32) == label {
-                    agrees[row * w + col] = true;
+            let corners = &corners[..n];
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for c in corners {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
                 }
             }
-        }
-    }
-    agrees.iter().filter(|&&a| a).count() as f64 / (w * h) as f64
+            // Pixel centres (col + 0.5, row + 0.5) inside the bounding box.
+            let first = |x: f64| (x - 0.5).ceil().max(0.0) as usize;
+            let last = |x: f64, n: usize| ((x - 0.5).floor().min(n as f64 - 1.0)).max(-1.0);
+            let (c0, r0) = (first(lo[0]), first(lo[1]));
+            let (c1, r1) = (last(hi[0], w), last(hi[1], h));
+            let (rows, cols) = if c1 < 0.0 || r1 < 0.0 {
+                (r0..r0, c0..c0)
+            } else {
+                (r0..r1 as usize + 1, c0..c1 as usize + 1)
+            };
+            for row in rows {
+                for col in cols.clone() {
+                    let p = [col as f64 + 0.5, row as f64 + 0.5];
+                    let inside = (0..n).all(|i| {
+                        let (a, b) = (corners[i], corners[(i + 1) % n]);
+                        (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0.0
+                    });
+                    if inside && grid.label(col as u32, row as u32) == label {
+                        agrees[row * w + col].store(true, Ordering::Relaxed);
+                    }
+                }
+            }
+        });
+    let agreeing = agrees.iter().filter(|a| a.load(Ordering::Relaxed)).count();
+    agreeing as f64 / (w * h) as f64
 }
 
 #[cfg(test)]
