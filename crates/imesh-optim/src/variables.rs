@@ -337,24 +337,24 @@ impl Variables {
             row.sort_unstable();
             quads.push_row(row.iter().copied());
         }
-        let mut corner_weights = Rows::new();
+        // Each quad corner's weight, found in the variable's short influence row.
+        let mut items: Vec<[f64; 4]> = Vec::with_capacity(quads.items.len());
         for i in 0..influence.len() {
-            let weight = |v: u32| {
-                // Rows are short (a point moves at most a patch's vertices): a scan beats a
-                // search.
-                influence
-                    .row(i)
-                    .iter()
-                    .find(|&&(u, _)| u == v)
-                    .map_or(0.0, |&(_, w)| w)
-            };
-            corner_weights.push_row(
-                quads
-                    .row(i)
-                    .iter()
-                    .map(|&q| mesh.quads[q as usize].map(weight)),
-            );
+            let row = influence.row(i);
+            for &q in quads.row(i) {
+                let mut w = [0.0; 4];
+                for (k, &v) in mesh.quads[q as usize].iter().enumerate() {
+                    if let Some(&(_, x)) = row.iter().find(|&&(u, _)| u == v) {
+                        w[k] = x;
+                    }
+                }
+                items.push(w);
+            }
         }
+        let corner_weights = Rows {
+            first: quads.first.clone(),
+            items,
+        };
         let by_quad = by_quad(&quads, mesh.quads.len());
         let colours = colour(&quads, &by_quad);
         Self {
