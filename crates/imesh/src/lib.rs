@@ -2091,13 +2091,11 @@ fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: 
             let last = |x: f64, n: usize| ((x - 0.5).floor().min(n as f64 - 1.0)).max(-1.0);
             let (c0, r0) = (first(lo[0]), first(lo[1]));
             let (c1, r1) = (last(hi[0], w), last(hi[1], h));
-            let (rows, cols) = if c1 < 0.0 || r1 < 0.0 {
-                (r0..r0, c0..c0)
-            } else {
-                (r0..r1 as usize + 1, c0..c1 as usize + 1)
-            };
-            for row in rows {
-                for col in cols.clone() {
+            if c1 < 0.0 || r1 < 0.0 {
+                return;
+            }
+            for row in r0..=r1 as usize {
+                for col in c0..=c1 as usize {
                     let p = [col as f64 + 0.5, row as f64 + 0.5];
                     let inside = (0..n).all(|i| {
                         let (a, b) = (corners[i], corners[(i + 1) % n]);
