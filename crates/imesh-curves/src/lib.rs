@@ -16,7 +16,9 @@
 //!   G' and reports the errors;
 //! - [`open_sharp_corners`]: where two boundaries leave a vertex closer than a quad corner
 //!   should be (30°), the curves' ends turned apart within the tolerance
-//!   ([`fit_cubic_with_tangents`]).
+//!   ([`fit_cubic_with_tangents`]);
+//! - [`blunt_sharp_tips`]: a region's tip still that sharp cut off where it is about a quad
+//!   side wide, the triangle beyond given to a neighbour.
 //!
 //! ```
 //! use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
@@ -43,6 +45,7 @@ mod graph;
 mod grid;
 mod polyline;
 mod simplify;
+mod tips;
 
 use rayon::prelude::*;
 
@@ -59,6 +62,7 @@ pub use simplify::{
     neck_vertices, sharp_vertices, simplify, Simplification, SimplifyOptions, DEFAULT_TOLERANCE,
     MERGE_SPAN, NECK_RATIO, SHARP_GAIN_DEG, SHARP_SECTOR_DEG, WEDGE_ANGLE_DEG,
 };
+pub use tips::{blunt_sharp_tips, Blunted, TipOptions};
 
 /// Errors of the curve stage.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

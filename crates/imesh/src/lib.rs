@@ -25,8 +25,9 @@ use std::time::Instant;
 
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, LabelGrid};
 use imesh_curves::{
-    contract_short_links, fit_edges, neck_vertices, open_sharp_corners, sharp_vertices, simplify,
-    CornerOptions, CurveGraph, FitOptions, GraphEdge, Simplification, SimplifyOptions,
+    blunt_sharp_tips, contract_short_links, fit_edges, neck_vertices, open_sharp_corners,
+    sharp_vertices, simplify, CornerOptions, CurveGraph, FitOptions, GraphEdge, Simplification,
+    SimplifyOptions, TipOptions,
 };
 use imesh_geom::{RefineOptions, StopReason, TriangleId, Triangulation, VertexId};
 use imesh_io::SegmentedMeshData;
@@ -349,6 +350,11 @@ pub struct MeshOptions {
     /// Most elements the mesh may have: checked up front against a lower bound (with
     /// `max_size`), caps the refinement, and checked exactly before the templates are built.
     pub max_elements: u64,
+    /// Keep the regions' tips sharper than 30° that the curves could not open, instead of
+    /// cutting them off where they are one to two quad sides wide
+    /// ([`imesh_curves::blunt_sharp_tips`], uniform quads only): the quad at such a tip has a
+    /// corner that sharp, a scaled Jacobian under 0.5.
+    pub keep_sharp_tips: bool,
 }
 
 /// Default [`MeshOptions::max_elements`]: five million elements (about 1.5 GB at the peak of a
@@ -379,6 +385,7 @@ impl Default for MeshOptions {
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
             max_labels: imesh_classify::DEFAULT_MAX_LABELS,
             max_elements: DEFAULT_MAX_ELEMENTS,
+            keep_sharp_tips: false,
         }
     }
 }
@@ -480,6 +487,14 @@ pub struct Counts {
     pub opened_corners: usize,
     /// Curves it refitted with turned ends, within the curve tolerance of their boundaries.
     pub turned_curves: usize,
+    /// Sharp tips cut off where they were a quad side wide
+    /// ([`imesh_curves::blunt_sharp_tips`]): sectors the curves could not open.
+    pub blunted_tips: usize,
+    /// The area those tips gave to their neighbours, in square pixels.
+    pub blunted_area_px: f64,
+    /// The farthest a cut moved a boundary (from a tip's vertex to its cut), in pixels: the
+    /// boundary's Hausdorff distance includes it.
+    pub blunted_depth_px: f64,
     /// Boundary vertices kept where two simplified edges would have left a vertex less than
     /// [`imesh_curves::SHARP_SECTOR_DEG`] apart though the boundaries leave it wider
     /// ([`imesh_curves::sharp_vertices`], at [`SHARP_LENGTH`] quad sides from it).
@@ -988,6 +1003,8 @@ impl Pipeline {
         counts.quad_size *= sx;
         counts.dt_spacing *= sx;
         counts.merged_area *= sx * sy;
+        counts.blunted_area_px *= sx * sy;
+        counts.blunted_depth_px *= sx.max(sy);
         let report = &mut result.report;
         // The options as given, the tolerance as used (in pixels).
         let tolerance = report.options.tolerance.map(|t| t * (sx * sy).sqrt());
@@ -1380,23 +1397,40 @@ impl Pipeline {
         counts.opened_corners = corners.sharp;
         counts.turned_curves = corners.refitted;
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
+        // Sharp tips the curves could not open are cut off where they are a quad side wide
+        // (uniform quads only).
+        let tips = quad_size.filter(|_| !o.keep_sharp_tips).and_then(|q| {
+            blunt_sharp_tips(
+                &simplified.graph,
+                &curves,
+                &TipOptions {
+                    width: q,
+                    reach: q,
+                    ..TipOptions::default()
+                },
+            )
+        });
+        let (graph, curves, tip_moved) = match tips {
+            Some(b) => {
+                counts.blunted_tips = b.tips;
+                counts.blunted_area_px = b.area;
+                counts.blunted_depth_px = b.moved;
+                (b.graph, b.curves, b.moved)
+            }
+            None => (simplified.graph, curves, 0.0),
+        };
         let fitting = start.elapsed().as_secs_f64();
         seconds.curves += fitting;
         pictures.add("simplified", || {
-            let points: Vec<[f64; 2]> = simplified
-                .graph
-                .points()
-                .iter()
-                .map(|p| [p.x, p.y])
-                .collect();
-            let lines = segments(&points, simplified.graph.edges().iter().map(|e| e.ends));
+            let points: Vec<[f64; 2]> = graph.points().iter().map(|p| [p.x, p.y]).collect();
+            let lines = segments(&points, graph.edges().iter().map(|e| e.ends));
             (Vec::new(), Vec::new(), Vec::new(), lines)
         });
         self.stage(Stage::Quads);
         let quad_size = match (quad_size, o.size) {
             (Some(q), ElementSize::Auto) => {
                 let (w, h) = (f64::from(counts.width), f64::from(counts.height));
-                let q = band_limited_size(&simplified.graph, w, h, q);
+                let q = band_limited_size(&graph, w, h, q);
                 counts.quad_size = q;
                 Some(q)
             }
@@ -1405,7 +1439,7 @@ impl Pipeline {
         let spacing = quad_size.map(|q| 2.0 * f64::from(o.template_level) * q);
         let remesh_with = |lattice_scale: f64| {
             remesh(
-                &simplified.graph,
+                &graph,
                 &curves,
                 &QuadOptions {
                     density: DensityOptions {
@@ -1462,7 +1496,7 @@ impl Pipeline {
         seconds.dt = r.seconds.triangulation;
         seconds.pairing_templates = r.seconds.templates;
         seconds.adaptation = r.seconds.adaptation;
-        counts.simplified_edges = simplified.graph.edges().len();
+        counts.simplified_edges = graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
         counts.dt_spacing = spacing.unwrap_or(0.0);
         counts.refinement_points = r.dt.refinement.inserted;
@@ -1480,13 +1514,8 @@ impl Pipeline {
             Vec::new()
         };
         let graph_lines = || {
-            let points: Vec<[f64; 2]> = simplified
-                .graph
-                .points()
-                .iter()
-                .map(|p| [p.x, p.y])
-                .collect();
-            segments(&points, simplified.graph.edges().iter().map(|e| e.ends))
+            let points: Vec<[f64; 2]> = graph.points().iter().map(|p| [p.x, p.y]).collect();
+            segments(&points, graph.edges().iter().map(|e| e.ends))
         };
         pictures.add("dt", || {
             let t = &r.dt.triangulation;
@@ -1547,7 +1576,7 @@ impl Pipeline {
         seconds.optimise = optimisation.seconds;
         let (sas_after, sj_after) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         *optimised = Some(QuadExtras {
-            hausdorff: fits.max_error.max(fits.max_curve_deviation),
+            hausdorff: fits.max_error.max(fits.max_curve_deviation).max(tip_moved),
             optimisation: Optimisation {
                 method: o.optimizer,
                 metric: o.metric,

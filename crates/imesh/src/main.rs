@@ -144,6 +144,11 @@ struct MeshFlags {
     /// uniform quads, none otherwise].
     #[arg(long)]
     min_width: Option<AutoOr<f64>>,
+    /// Keep the regions' tips sharper than 30° as the image has them (the quad there keeps a
+    /// corner that sharp) instead of cutting them off where they are a quad side or two wide
+    /// (uniform quads; the report's counts.blunted_tips and blunted_area_px).
+    #[arg(long)]
+    keep_sharp_tips: bool,
     /// Mesh a reduced grid whose cells are the most common label of about F × F pixels, then
     /// scale the mesh back: auto (uniform quads 8 px wide or more, e.g. a large image or a
     /// large --size: F makes them 4 to 8 cells wide), 1 (never) or F. Options given in pixels
@@ -294,6 +299,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(f) = args.reduction {
         o.reduction = f.value();
+    }
+    if args.keep_sharp_tips {
+        o.keep_sharp_tips = true;
     }
     if let Some(e) = args.elements {
         o.elements = e;
@@ -625,6 +633,14 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
                     corner.angle_deg, corner.at[0], corner.at[1]
                 );
             }
+        }
+        if c.blunted_tips > 0 {
+            println!(
+                "cut off {} region tip{} sharper than 30° where a quad side or two wide ({:.1} px² to their neighbours; --keep-sharp-tips keeps them)",
+                c.blunted_tips,
+                if c.blunted_tips == 1 { "" } else { "s" },
+                c.blunted_area_px
+            );
         }
         if c.reduction > 1 {
             println!(

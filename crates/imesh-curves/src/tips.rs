@@ -1,0 +1,671 @@
+//! Blunting sharp tips: where a region's corner at a vertex of G' stays narrower than a quad's
+//! corner should be, the tip is cut off by a short edge across it and given to a neighbour.
+//!
+//! A quad at such a vertex has its corner inside the region's sector, so its scaled Jacobian is
+//! at most the sector's sine whatever the optimiser does: sharper than 30°, under 0.5. Where
+//! [`crate::open_sharp_corners`] could not open the sector within the curve tolerance (a spike
+//! tip, a junction, a boundary meeting the border at a grazing angle), the only way to better
+//! elements is to change the region there. Cutting the tip where it is a quad side wide gives
+//! the region two corners of 90° + θ/2 and its neighbour a triangle of about one quad's area
+//! whose corners are 90° − θ/2 and θ, the θ joining the neighbour's own corner at the vertex.
+
+use imesh_geom::predicates::orient2d;
+use imesh_geom::Point;
+
+use crate::{CubicBezier, CurveGraph, GraphEdge};
+
+/// The label of the outside of the domain: a tip is never given to it.
+const OUTSIDE: u32 = u32::MAX;
+
+/// The widths a tip is cut at, in [`TipOptions::width`]s: the widest its edges leave room for.
+const WIDTHS: [f64; 3] = [2.0, 1.5, 1.0];
+
+/// Options of [`blunt_sharp_tips`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TipOptions {
+    /// Sectors narrower than this (degrees) are cut.
+    pub min_angle_deg: f64,
+    /// The width of the cut (pixels): about a quad side, so that the new edge holds one
+    /// element edge.
+    pub width: f64,
+    /// How far from the vertex (pixels) a boundary's curve direction is taken, as in
+    /// [`crate::CornerOptions::reach`]; the sector is the narrower of the chords' and the
+    /// curves'.
+    pub reach: f64,
+    /// The deepest cut, in widths from the vertex: a sharper tip is cut there, narrower than
+    /// `width`, which still leaves right-ish corners.
+    pub max_depth: f64,
+}
+
+impl Default for TipOptions {
+    fn default() -> Self {
+        Self {
+            min_angle_deg: crate::MIN_CORNER_DEG,
+            width: 2.0,
+            reach: 2.0,
+            max_depth: 3.0,
+        }
+    }
+}
+
+/// G' with its sharp tips cut off ([`blunt_sharp_tips`]).
+#[derive(Clone, Debug)]
+pub struct Blunted {
+    /// The graph: the cut edges shortened, a new edge across each tip.
+    pub graph: CurveGraph,
+    /// One curve per edge of `graph`.
+    pub curves: Vec<CubicBezier>,
+    /// Tips cut.
+    pub tips: usize,
+    /// The area the tips' regions gave away, in square pixels.
+    pub area: f64,
+    /// The farthest a boundary moved: the largest distance from a cut tip's vertex to its cut.
+    pub moved: f64,
+}
+
+/// One end of an edge at a vertex.
+#[derive(Clone, Copy, Debug)]
+struct End {
+    edge: u32,
+    /// The vertex is the edge's `ends[0]`.
+    at_start: bool,
+    /// The far end's point.
+    far: Point,
+    /// Directions (radians) of the chord and of the curve `reach` out.
+    chord: f64,
+    curve: f64,
+}
+
+impl End {
+    /// The labels on the left and the right of the edge leaving the vertex.
+    fn sides(&self, g: &CurveGraph) -> [u32; 2] {
+        let l = g.edges()[self.edge as usize].labels;
+        if self.at_start {
+            l
+        } else {
+            [l[1], l[0]]
+        }
+    }
+}
+
+/// A tip to cut: the sector from `ends[0]` counter-clockwise to `ends[1]` at `vertex`.
+#[derive(Clone, Copy, Debug)]
+struct Tip {
+    vertex: u32,
+    ends: [End; 2],
+    region: u32,
+    receiver: u32,
+    /// The narrower of the chord and curve sectors (radians).
+    angle: f64,
+    /// Distance of the cut from the vertex along each chord.
+    depth: f64,
+}
+
+/// Cuts off every sector of G' narrower than `options.min_angle_deg` (the narrower of the
+/// straight edges' and of the fitted curves' directions `options.reach` out) where it is
+/// `options.width` wide (at most `options.max_depth` widths from the vertex): a new vertex on
+/// each of the two straight edges, a straight edge between them, and the triangle beyond given
+/// to the region across the first edge (the second's when the first is the domain's border).
+/// The curves are cut at the new vertices' projections, their ends moved onto them. A sector is
+/// left alone when one of its edges is too short to cut, already cut at its other end, or a
+/// vertex of the graph lies in the triangle. `None` when nothing was cut.
+///
+/// ```
+/// use imesh_curves::{blunt_sharp_tips, CubicBezier, CurveGraph, GraphEdge, TipOptions};
+/// use imesh_geom::Point;
+/// // A 20° spike of region 1 in region 0, its sides 20 px long, closed by a third edge.
+/// let a = 10f64.to_radians();
+/// let points = vec![
+///     Point::new(0.0, 0.0),
+///     Point::new(20.0 * a.cos(), 20.0 * a.sin()),
+///     Point::new(20.0 * a.cos(), -20.0 * a.sin()),
+/// ];
+/// let edges = vec![
+///     GraphEdge { ends: [0, 1], labels: [0, 1] },
+///     GraphEdge { ends: [1, 2], labels: [0, 1] },
+///     GraphEdge { ends: [2, 0], labels: [0, 1] },
+/// ];
+/// let g = CurveGraph::new(points, edges)?;
+/// let curves: Vec<_> = g.edges().iter().map(|e| CubicBezier::segment(g.point(e.ends[0]), g.point(e.ends[1]))).collect();
+/// let b = blunt_sharp_tips(&g, &curves, &TipOptions { width: 2.0, ..TipOptions::default() }).unwrap();
+/// assert_eq!(b.tips, 1);
+/// // The tip is gone: no edge uses vertex 0; the two sides end at the cut, 4 px wide (the
+/// // widest of 2, 1.5 and 1 widths the 20 px sides leave room for).
+/// assert!(b.graph.edges().iter().all(|e| !e.ends.contains(&0)));
+/// assert_eq!(b.graph.edges().len(), 4);
+/// let cut = b.graph.edges()[3].ends.map(|v| b.graph.point(v));
+/// assert!((cut[0].distance_squared(cut[1]).sqrt() - 4.0).abs() < 1e-9);
+/// # Ok::<(), imesh_curves::CurveError>(())
+/// ```
+pub fn blunt_sharp_tips(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    options: &TipOptions,
+) -> Option<Blunted> {
+    if curves.len() != g.edges().len() || !(options.width > 0.0 && options.width.is_finite()) {
+        return None;
+    }
+    let mut tips = sharp_tips(g, curves, options);
+    // The sharpest first; an edge is cut at one end only.
+    tips.sort_by(|a, b| a.angle.total_cmp(&b.angle));
+    let mut used = vec![false; g.edges().len()];
+    let mut cuts = Vec::new();
+    for tip in tips {
+        let [a, b] = tip.ends;
+        if used[a.edge as usize] || used[b.edge as usize] {
+            continue;
+        }
+        let v = g.point(tip.vertex);
+        let at = |e: &End| v + (e.far - v) * (tip.depth / norm(e.far - v));
+        let (p1, p2) = (at(&a), at(&b));
+        if !clear_triangle(g, tip.vertex, [v, p1, p2]) {
+            continue;
+        }
+        used[a.edge as usize] = true;
+        used[b.edge as usize] = true;
+        cuts.push((tip, [p1, p2]));
+    }
+    if cuts.is_empty() {
+        return None;
+    }
+    let mut points = g.points().to_vec();
+    let mut replaced: Vec<Option<Vec<(GraphEdge, CubicBezier)>>> = vec![None; g.edges().len()];
+    let mut added = Vec::new();
+    let (mut area, mut moved) = (0.0, 0.0f64);
+    for (tip, cut) in &cuts {
+        let ids = [points.len() as u32, points.len() as u32 + 1];
+        points.extend(cut);
+        for (end, (&p, &id)) in tip.ends.iter().zip(cut.iter().zip(&ids)) {
+            replaced[end.edge as usize] = Some(split(g, curves, end, p, id, tip));
+        }
+        let v = g.point(tip.vertex);
+        let labels = if orient2d(cut[0], cut[1], v) > 0.0 {
+            [tip.receiver, tip.region]
+        } else {
+            [tip.region, tip.receiver]
+        };
+        added.push((
+            GraphEdge { ends: ids, labels },
+            CubicBezier::segment(cut[0], cut[1]),
+        ));
+        let twice_area = cross(cut[0] - v, cut[1] - v).abs();
+        area += 0.5 * twice_area;
+        moved = moved.max(twice_area / norm(cut[1] - cut[0]));
+    }
+    let mut edges = Vec::with_capacity(g.edges().len() + 2 * cuts.len());
+    let mut new_curves = Vec::with_capacity(edges.capacity());
+    for (k, e) in g.edges().iter().enumerate() {
+        match &replaced[k] {
+            Some(pieces) => {
+                for &(piece, curve) in pieces {
+                    edges.push(piece);
+                    new_curves.push(curve);
+                }
+            }
+            None => {
+                edges.push(*e);
+                new_curves.push(curves[k]);
+            }
+        }
+    }
+    for (e, c) in added {
+        edges.push(e);
+        new_curves.push(c);
+    }
+    let mut graph = CurveGraph::new(points, edges).ok()?;
+    for v in 0..g.points().len() as u32 {
+        if g.is_pinned(v) {
+            graph.pin(v).ok()?;
+        }
+    }
+    Some(Blunted {
+        graph,
+        curves: new_curves,
+        tips: cuts.len(),
+        area,
+        moved,
+    })
+}
+
+/// Every sector of `g` narrower than the options' angle that may be cut.
+fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Tip> {
+    let min = options.min_angle_deg.to_radians();
+    let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
+    let mut tips = Vec::new();
+    let mut ends = Vec::new();
+    for v in 0..g.points().len() as u32 {
+        if g.valence(v) < 2 {
+            continue;
+        }
+        let p = g.point(v);
+        ends.clear();
+        ends.extend(g.incident(v).iter().map(|&k| {
+            let e = g.edges()[k as usize];
+            let at_start = e.ends[0] == v;
+            let far = g.point(if at_start { e.ends[1] } else { e.ends[0] });
+            let curve = if at_start {
+                curves[k as usize]
+            } else {
+                curves[k as usize].reversed()
+            };
+            let out = point_at_distance(&curve, p, options.reach);
+            End {
+                edge: k,
+                at_start,
+                far,
+                chord: direction(far - p),
+                curve: direction(out - p),
+            }
+        }));
+        ends.sort_by(|a, b| a.chord.total_cmp(&b.chord));
+        for i in 0..ends.len() {
+            let [a, b] = [ends[i], ends[(i + 1) % ends.len()]];
+            let chord = ccw(a.chord, b.chord);
+            let curve = ccw(a.curve, b.curve);
+            let angle = if curve < std::f64::consts::PI {
+                chord.min(curve)
+            } else {
+                chord
+            };
+            if chord >= std::f64::consts::PI || angle >= min {
+                continue;
+            }
+            let (left, right) = (a.sides(g), b.sides(g));
+            let region = left[0];
+            if region == OUTSIDE || right[1] != region {
+                continue;
+            }
+            let receiver = match (left[1], right[0]) {
+                (s, _) if s != OUTSIDE && s != region => s,
+                (_, s) if s != OUTSIDE && s != region => s,
+                _ => continue,
+            };
+            // The widest cut its edges leave room for, down to `width`: a cut one quad wide
+            // leaves the rest of a thin spike a quad wide too, a strip of half-size quads.
+            let cut = WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
+                let depth = (w / (2.0 * (chord / 2.0).sin())).min(options.max_depth * w);
+                let long_enough = |e: &End| norm(e.far - p) - depth >= 0.5 * options.width;
+                (depth.is_finite() && long_enough(&a) && long_enough(&b)).then_some(depth)
+            });
+            if let Some(depth) = cut {
+                tips.push(Tip {
+                    vertex: v,
+                    ends: [a, b],
+                    region,
+                    receiver,
+                    angle,
+                    depth,
+                });
+            }
+        }
+    }
+    tips
+}
+
+/// The pieces of `end`'s edge once cut at `p` (new vertex `id`): the far piece with the
+/// region's labels, and the near piece, relabelled with the receiver for the region, when it
+/// still separates two regions. Each keeps the edge's direction and its part of the curve, the
+/// end at the cut moved onto `p` (with the next control point, keeping the tangent).
+fn split(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    end: &End,
+    p: Point,
+    id: u32,
+    tip: &Tip,
+) -> Vec<(GraphEdge, CubicBezier)> {
+    let e = g.edges()[end.edge as usize];
+    let curve = curves[end.edge as usize];
+    let v = g.point(tip.vertex);
+    let share = norm(p - v) / norm(end.far - v);
+    let t = curve.closest_parameter(p, if end.at_start { share } else { 1.0 - share });
+    let (first, second) = curve.split(t);
+    let (first, second) = (moved_end(first, 3, p), moved_end(second, 0, p));
+    let relabel = |l: u32| if l == tip.region { tip.receiver } else { l };
+    let near_labels = e.labels.map(relabel);
+    let mut pieces = Vec::with_capacity(2);
+    let (near, far) = if end.at_start {
+        (
+            (
+                GraphEdge {
+                    ends: [e.ends[0], id],
+                    labels: near_labels,
+                },
+                first,
+            ),
+            (
+                GraphEdge {
+                    ends: [id, e.ends[1]],
+                    labels: e.labels,
+                },
+                second,
+            ),
+        )
+    } else {
+        (
+            (
+                GraphEdge {
+                    ends: [id, e.ends[1]],
+                    labels: near_labels,
+                },
+                second,
+            ),
+            (
+                GraphEdge {
+                    ends: [e.ends[0], id],
+                    labels: e.labels,
+                },
+                first,
+            ),
+        )
+    };
+    if near_labels[0] != near_labels[1] {
+        pieces.push(near);
+    }
+    pieces.push(far);
+    pieces
+}
+
+/// `c` with its control point `i` (0 or 3) moved to `p`, and its neighbour by the same offset.
+fn moved_end(c: CubicBezier, i: usize, p: Point) -> CubicBezier {
+    let mut control = c.control;
+    let offset = p - control[i];
+    let next = if i == 0 { 1 } else { 2 };
+    control[i] = p;
+    control[next] = control[next] + offset;
+    CubicBezier::new(control)
+}
+
+/// True when no vertex of `g` but `v` lies in the closed triangle `t` (counter-clockwise or
+/// not).
+fn clear_triangle(g: &CurveGraph, v: u32, t: [Point; 3]) -> bool {
+    let (lo, hi) = t.iter().fold(
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
+    );
+    let sign = orient2d(t[0], t[1], t[2]).signum();
+    g.points().iter().enumerate().all(|(u, &q)| {
+        u as u32 == v
+            || q.x < lo.x
+            || q.x > hi.x
+            || q.y < lo.y
+            || q.y > hi.y
+            || g.valence(u as u32) == 0
+            || (0..3).any(|k| orient2d(t[k], t[(k + 1) % 3], q) * sign < 0.0)
+    })
+}
+
+/// The point of `curve` (starting at `from`) first `distance` away from it, or its end when
+/// the curve never gets that far.
+fn point_at_distance(curve: &CubicBezier, from: Point, distance: f64) -> Point {
+    let end = curve.eval(1.0);
+    if norm(end - from) <= distance {
+        return end;
+    }
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if norm(curve.eval(mid) - from) < distance {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    curve.eval(hi)
+}
+
+/// The length of `d`.
+fn norm(d: Point) -> f64 {
+    (d.x * d.x + d.y * d.y).sqrt()
+}
+
+/// The cross product of `a` and `b`.
+fn cross(a: Point, b: Point) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// The direction of `d` in radians.
+fn direction(d: Point) -> f64 {
+    d.y.atan2(d.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::HashMap;
+
+    /// Straight curves for every edge of `g`.
+    fn straight(g: &CurveGraph) -> Vec<CubicBezier> {
+        g.edges()
+            .iter()
+            .map(|e| CubicBezier::segment(g.point(e.ends[0]), g.point(e.ends[1])))
+            .collect()
+    }
+
+    /// Each label's area (its faces' signed areas summed: an island's hole counts against it).
+    fn areas(g: &CurveGraph) -> HashMap<u32, f64> {
+        let mut a = HashMap::new();
+        for f in g.faces() {
+            assert!(f.consistent, "a face walk with mixed labels");
+            *a.entry(f.label).or_insert(0.0) += f.area;
+        }
+        a
+    }
+
+    /// The smallest angle (degrees) of a region at vertex `v`: between consecutive edges.
+    fn sectors_at(g: &CurveGraph, v: u32) -> Vec<(u32, f64)> {
+        let p = g.point(v);
+        let mut out: Vec<(f64, u32, u32)> = g
+            .incident(v)
+            .iter()
+            .map(|&k| {
+                let e = g.edges()[k as usize];
+                let (far, left) = if e.ends[0] == v {
+                    (g.point(e.ends[1]), e.labels[0])
+                } else {
+                    (g.point(e.ends[0]), e.labels[1])
+                };
+                (direction(far - p), k, left)
+            })
+            .collect();
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        (0..out.len())
+            .map(|i| {
+                let (a, b) = (out[i], out[(i + 1) % out.len()]);
+                let angle = (b.0 - a.0).rem_euclid(std::f64::consts::TAU).to_degrees();
+                (a.2, if out.len() == 1 { 360.0 } else { angle })
+            })
+            .collect()
+    }
+
+    /// A wedge of region 1 from the origin between the directions 0° and `angle`, its sides
+    /// `length` long, in a square of region 0 (with `junction`, the square's lower half, below
+    /// the wedge's lower side and its extensions, is region 2), rotated by `turn` degrees.
+    fn wedge(angle: f64, length: f64, turn: f64, junction: bool) -> CurveGraph {
+        let t = turn.to_radians();
+        let at = |x: f64, y: f64| {
+            let (sin, cos) = t.sin_cos();
+            Point::new(x * cos - y * sin, x * sin + y * cos)
+        };
+        let (a, s) = (angle.to_radians(), 3.0 * length);
+        let points = vec![
+            at(0.0, 0.0),
+            at(length, 0.0),
+            at(length * a.cos(), length * a.sin()),
+            at(-s, 0.0),
+            at(s, 0.0),
+            at(-s, -s),
+            at(s, -s),
+            at(s, s),
+            at(-s, s),
+        ];
+        let below = if junction { 2 } else { 0 };
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        // Each label on the left of its edge's direction.
+        let mut edges = vec![
+            e(0, 1, [1, below]),
+            e(1, 2, [1, 0]),
+            e(2, 0, [1, 0]),
+            e(5, 6, [below, OUTSIDE]),
+            e(6, 4, [below, OUTSIDE]),
+            e(4, 7, [0, OUTSIDE]),
+            e(7, 8, [0, OUTSIDE]),
+            e(8, 3, [0, OUTSIDE]),
+            e(3, 5, [below, OUTSIDE]),
+        ];
+        if junction {
+            edges.push(e(3, 0, [0, 2]));
+            edges.push(e(1, 4, [0, 2]));
+        }
+        CurveGraph::new(points, edges).unwrap()
+    }
+
+    /// A spike of region 1 in region 0: cut where it is the width wide, the region's two new
+    /// corners right-ish, the tip's area given to region 0, the tip vertex left unused.
+    #[test]
+    fn a_spike_tip_is_cut_where_it_is_one_width_wide() {
+        let g = wedge(20.0, 30.0, 15.0, false);
+        let options = TipOptions {
+            width: 2.0,
+            reach: 2.0,
+            ..TipOptions::default()
+        };
+        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        // The widest cut that leaves room: two widths (4 px) across, 11.5 px from the tip.
+        let cut = b.graph.edges().last().unwrap();
+        let [p, q] = cut.ends.map(|v| b.graph.point(v));
+        assert!((norm(q - p) - 4.0).abs() < 1e-9);
+        for v in cut.ends {
+            for (label, angle) in sectors_at(&b.graph, v) {
+                if label == 1 {
+                    assert!((angle - 100.0).abs() < 1e-6, "{angle}");
+                }
+            }
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+        assert!((b.moved - 4.0 / (2.0 * 10f64.to_radians().tan())).abs() < 1e-9);
+    }
+
+    /// A wedge between two other regions at a junction: the tip goes to the region across its
+    /// first side (counter-clockwise: the lower one), and the piece of its other side near the
+    /// junction stays, now between the two neighbours.
+    #[test]
+    fn a_junction_tip_keeps_the_boundary_between_its_neighbours() {
+        let g = wedge(16.0, 30.0, -40.0, true);
+        let b = blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        let kept: Vec<&GraphEdge> = b
+            .graph
+            .edges()
+            .iter()
+            .filter(|e| e.ends.contains(&0))
+            .collect();
+        // The tip vertex keeps the boundary between regions 0 and 2 on its left, and the near
+        // piece of the wedge's upper side, now between them too.
+        assert_eq!(kept.len(), 2);
+        assert!(kept.iter().all(|e| !e.labels.contains(&1)));
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&0] - after[&0]).abs() < 1e-9);
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&2] - before[&2] - b.area).abs() < 1e-9);
+        assert!(sectors_at(&b.graph, 0).iter().all(|&(_, a)| a > 30.0));
+    }
+
+    /// Where one side of the tip is the domain's border, the tip goes to the region across the
+    /// other side, and the border keeps its line.
+    #[test]
+    fn a_tip_on_the_border_goes_to_the_inner_neighbour() {
+        // Region 1: a 20° sliver along the bottom border y = 0, from the corner (0, 0).
+        let a = 20f64.to_radians();
+        let points = vec![
+            Point::new(0.0, 0.0),
+            Point::new(30.0, 0.0),
+            Point::new(30.0, 30.0 * a.tan()),
+            Point::new(40.0, 0.0),
+            Point::new(40.0, 40.0),
+            Point::new(0.0, 40.0),
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let edges = vec![
+            e(0, 1, [1, OUTSIDE]),
+            e(1, 2, [1, 0]),
+            e(2, 0, [1, 0]),
+            e(1, 3, [0, OUTSIDE]),
+            e(3, 4, [0, OUTSIDE]),
+            e(4, 5, [0, OUTSIDE]),
+            e(5, 0, [0, OUTSIDE]),
+        ];
+        let g = CurveGraph::new(points, edges).unwrap();
+        let b = blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        // The border near the corner now bounds region 0.
+        let near = b.graph.edges().iter().find(|e| e.ends[0] == 0).unwrap();
+        assert_eq!(near.labels, [0, OUTSIDE]);
+        assert_eq!(b.graph.point(near.ends[1]).y, 0.0);
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+    }
+
+    /// Nothing to cut: a sector of 40°, and a 20° tip whose sides are too short.
+    #[test]
+    fn wide_or_short_tips_are_left() {
+        let g = wedge(40.0, 30.0, 0.0, false);
+        assert!(blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).is_none());
+        let g = wedge(20.0, 4.0, 0.0, false);
+        assert!(blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).is_none());
+    }
+
+    proptest! {
+        /// Any wedge of 3–29°, any length and turn, with or without a junction: the graph stays
+        /// planar with consistent faces, the area moves only from the wedge's region to the
+        /// receiver, and the wedge's corners at the cut are at least 90°.
+        #[test]
+        fn cut_tips_keep_the_graph_sound(
+            angle in 3.0f64..29.0,
+            length in 5.0f64..60.0,
+            turn in -180.0f64..180.0,
+            junction: bool,
+            width in 0.5f64..4.0,
+        ) {
+            let g = wedge(angle, length, turn, junction);
+            let options = TipOptions { width, reach: width, ..TipOptions::default() };
+            if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
+                prop_assert!(b.graph.crossing().is_none());
+                let (before, after) = (areas(&g), areas(&b.graph));
+                let scale = length * length;
+                prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
+                prop_assert!(b.area > 0.0);
+                let cut = b.graph.edges().last().unwrap();
+                for v in cut.ends {
+                    for (label, a) in sectors_at(&b.graph, v) {
+                        if label == 1 {
+                            prop_assert!(a >= 90.0 - 1e-6, "{}", a);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
