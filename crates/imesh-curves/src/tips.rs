@@ -25,8 +25,8 @@ const WIDTHS: [f64; 3] = [2.0, 1.5, 1.0];
 pub struct TipOptions {
     /// Sectors narrower than this (degrees) are cut.
     pub min_angle_deg: f64,
-    /// The width of the cut (pixels): about a quad side, so that the new edge holds one
-    /// element edge.
+    /// The narrowest cut (pixels): about a quad side, so that the new edge holds an element
+    /// edge. Cuts of twice and 1.5 times this are tried first.
     pub width: f64,
     /// How far from the vertex (pixels) a boundary's curve direction is taken, as in
     /// [`crate::CornerOptions::reach`]; the sector is the narrower of the chords' and the
@@ -102,13 +102,15 @@ struct Tip {
 }
 
 /// Cuts off every sector of G' narrower than `options.min_angle_deg` (the narrower of the
-/// straight edges' and of the fitted curves' directions `options.reach` out) where it is
-/// `options.width` wide (at most `options.max_depth` widths from the vertex): a new vertex on
+/// straight edges' and of the fitted curves' directions `options.reach` out) where it is two,
+/// 1.5 or one `options.width` wide, the widest its edges leave room for (at most
+/// `options.max_depth` of those widths from the vertex): a new vertex on
 /// each of the two straight edges, a straight edge between them, and the triangle beyond given
 /// to the region across the first edge (the second's when the first is the domain's border).
 /// The curves are cut at the new vertices' projections, their ends moved onto them. A sector is
 /// left alone when one of its edges is too short to cut, already cut at its other end, or a
-/// vertex of the graph lies in the triangle. `None` when nothing was cut.
+/// vertex of the graph lies in the triangle. `None` when nothing was cut (or when two cuts
+/// would cross: then none is made).
 ///
 /// ```
 /// use imesh_curves::{blunt_sharp_tips, CubicBezier, CurveGraph, GraphEdge, TipOptions};
@@ -217,6 +219,11 @@ pub fn blunt_sharp_tips(
         if g.is_pinned(v) {
             graph.pin(v).ok()?;
         }
+    }
+    // Each cut lies in its own tip, which holds no vertex; two tips of one region folded onto
+    // each other could still overlap: then nothing is cut rather than a graph that crosses.
+    if graph.crossing().is_some() {
+        return None;
     }
     Some(Blunted {
         graph,
