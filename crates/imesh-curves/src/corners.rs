@@ -239,7 +239,7 @@ const TANGENT_FACTORS: [f64; 4] = [1.0, 1.5, 2.0, 3.0];
 
 /// The direction from `curve`'s start (`at_start`) or end to its first point `reach` away (its
 /// other end if none is), or `None` for a curve with no length.
-fn chord(curve: &CubicBezier, at_start: bool, reach: f64) -> Option<Point> {
+pub(crate) fn chord(curve: &CubicBezier, at_start: bool, reach: f64) -> Option<Point> {
     let from = if at_start {
         curve.control[0]
     } else {

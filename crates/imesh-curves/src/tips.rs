@@ -12,6 +12,7 @@
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 
+use crate::corners::chord;
 use crate::{CubicBezier, CurveGraph, GraphEdge};
 
 /// The label of the outside of the domain: a tip is never given to it.
@@ -167,14 +168,42 @@ pub fn blunt_sharp_tips(
         used[b.edge as usize] = true;
         cuts.push((tip, [p1, p2]));
     }
-    if cuts.is_empty() {
-        return None;
+    // A cut whose new corners would be sharp themselves (a curve turning back across its
+    // chord near the cut) is dropped, and the rest made again.
+    let min = options.min_angle_deg.to_radians();
+    loop {
+        if cuts.is_empty() {
+            return None;
+        }
+        let blunted = cut_off(g, curves, &cuts)?;
+        let first_new = g.points().len() as u32;
+        let sharp: Vec<usize> = (0..cuts.len())
+            .filter(|&i| {
+                let ids = [first_new + 2 * i as u32, first_new + 2 * i as u32 + 1];
+                ids.iter().any(|&v| {
+                    sectors(&blunted.graph, &blunted.curves, v, options.reach)
+                        .iter()
+                        .any(|s| s.angle < min)
+                })
+            })
+            .collect();
+        if sharp.is_empty() {
+            return Some(blunted);
+        }
+        for &i in sharp.iter().rev() {
+            cuts.remove(i);
+        }
     }
+}
+
+/// G' with the tips of `cuts` cut off (each with its two cut points, new vertices
+/// `n + 2i` and `n + 2i + 1` for `n` points in `g`); `None` if the graph would not be sound.
+fn cut_off(g: &CurveGraph, curves: &[CubicBezier], cuts: &[(Tip, [Point; 2])]) -> Option<Blunted> {
     let mut points = g.points().to_vec();
     let mut replaced: Vec<Option<Vec<(GraphEdge, CubicBezier)>>> = vec![None; g.edges().len()];
     let mut added = Vec::new();
     let (mut area, mut moved) = (0.0, 0.0f64);
-    for (tip, cut) in &cuts {
+    for (tip, cut) in cuts {
         let ids = [points.len() as u32, points.len() as u32 + 1];
         points.extend(cut);
         for (end, (&p, &id)) in tip.ends.iter().zip(cut.iter().zip(&ids)) {
@@ -234,38 +263,46 @@ pub fn blunt_sharp_tips(
     })
 }
 
-/// Every sector of `g` narrower than the options' angle that may be cut.
-fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Tip> {
-    let min = options.min_angle_deg.to_radians();
+/// A sector of a vertex of G': from `ends[0]` counter-clockwise to `ends[1]`.
+#[derive(Clone, Copy, Debug)]
+struct Sector {
+    ends: [End; 2],
+    /// Between the straight edges (radians).
+    chord: f64,
+    /// The narrower of that and the curves' sector `reach` out (when the curves keep their
+    /// order).
+    angle: f64,
+}
+
+/// The sectors of vertex `v` of `g` (none below valence 2), directions measured as in
+/// [`crate::open_sharp_corners`].
+fn sectors(g: &CurveGraph, curves: &[CubicBezier], v: u32, reach: f64) -> Vec<Sector> {
+    if g.valence(v) < 2 {
+        return Vec::new();
+    }
     let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
-    let mut tips = Vec::new();
-    let mut ends = Vec::new();
-    for v in 0..g.points().len() as u32 {
-        if g.valence(v) < 2 {
-            continue;
-        }
-        let p = g.point(v);
-        ends.clear();
-        ends.extend(g.incident(v).iter().map(|&k| {
+    let p = g.point(v);
+    let mut ends: Vec<End> = g
+        .incident(v)
+        .iter()
+        .map(|&k| {
             let e = g.edges()[k as usize];
             let at_start = e.ends[0] == v;
             let far = g.point(if at_start { e.ends[1] } else { e.ends[0] });
-            let curve = if at_start {
-                curves[k as usize]
-            } else {
-                curves[k as usize].reversed()
-            };
-            let out = point_at_distance(&curve, p, options.reach);
+            // The curve's direction as `open_sharp_corners` measures it.
+            let out = chord(&curves[k as usize], at_start, reach).unwrap_or(far - p);
             End {
                 edge: k,
                 at_start,
                 far,
                 chord: direction(far - p),
-                curve: direction(out - p),
+                curve: direction(out),
             }
-        }));
-        ends.sort_by(|a, b| a.chord.total_cmp(&b.chord));
-        for i in 0..ends.len() {
+        })
+        .collect();
+    ends.sort_by(|a, b| a.chord.total_cmp(&b.chord));
+    (0..ends.len())
+        .map(|i| {
             let [a, b] = [ends[i], ends[(i + 1) % ends.len()]];
             let chord = ccw(a.chord, b.chord);
             let curve = ccw(a.curve, b.curve);
@@ -274,9 +311,26 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             } else {
                 chord
             };
+            Sector {
+                ends: [a, b],
+                chord,
+                angle,
+            }
+        })
+        .collect()
+}
+
+/// Every sector of `g` narrower than the options' angle that may be cut.
+fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Tip> {
+    let min = options.min_angle_deg.to_radians();
+    let mut tips = Vec::new();
+    for v in 0..g.points().len() as u32 {
+        let p = g.point(v);
+        for Sector { ends, chord, angle } in sectors(g, curves, v, options.reach) {
             if chord >= std::f64::consts::PI || angle >= min {
                 continue;
             }
+            let [a, b] = ends;
             let (left, right) = (a.sides(g), b.sides(g));
             let region = left[0];
             if region == OUTSIDE || right[1] != region {
@@ -297,7 +351,7 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             if let Some(depth) = cut {
                 tips.push(Tip {
                     vertex: v,
-                    ends: [a, b],
+                    ends,
                     region,
                     receiver,
                     angle,
@@ -408,25 +462,6 @@ fn clear_triangle(g: &CurveGraph, v: u32, t: [Point; 3]) -> bool {
             || g.valence(u as u32) == 0
             || (0..3).any(|k| orient2d(t[k], t[(k + 1) % 3], q) * sign < 0.0)
     })
-}
-
-/// The point of `curve` (starting at `from`) first `distance` away from it, or its end when
-/// the curve never gets that far.
-fn point_at_distance(curve: &CubicBezier, from: Point, distance: f64) -> Point {
-    let end = curve.eval(1.0);
-    if norm(end - from) <= distance {
-        return end;
-    }
-    let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if norm(curve.eval(mid) - from) < distance {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    curve.eval(hi)
 }
 
 /// The length of `d`.
@@ -633,6 +668,28 @@ mod tests {
         assert_eq!(b.graph.point(near.ends[1]).y, 0.0);
         let (before, after) = (areas(&g), areas(&b.graph));
         assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+    }
+
+    /// A cut that would leave a sharp corner of its own is not made: the lower side's curve
+    /// swings far below its chord and back, so that where it is cut it heads nearly along the
+    /// cut edge.
+    #[test]
+    fn a_cut_that_would_be_sharp_itself_is_not_made() {
+        let g = wedge(20.0, 30.0, 0.0, false);
+        let options = TipOptions {
+            width: 2.0,
+            reach: 2.0,
+            ..TipOptions::default()
+        };
+        // As straight curves the tip is cut.
+        assert!(blunt_sharp_tips(&g, &straight(&g), &options).is_some());
+        let mut curves = straight(&g);
+        let (a, b) = (g.point(0), g.point(1));
+        curves[0] = CubicBezier::new([a, Point::new(8.0, -120.0), Point::new(13.0, 120.0), b]);
+        // The tip is still sharp and cut, but the cut's corner at the lower side would be
+        // sharp too.
+        assert_eq!(sharp_tips(&g, &curves, &options).len(), 1);
+        assert!(blunt_sharp_tips(&g, &curves, &options).is_none());
     }
 
     /// Nothing to cut: a sector of 40°, and a 20° tip whose sides are too short.
