@@ -485,6 +485,15 @@ mod tests {
     use proptest::prelude::*;
     use std::collections::HashMap;
 
+    /// Cuts of 2 px (and twice that), directions 2 px out.
+    fn two_px() -> TipOptions {
+        TipOptions {
+            width: 2.0,
+            reach: 2.0,
+            ..TipOptions::default()
+        }
+    }
+
     /// Straight curves for every edge of `g`.
     fn straight(g: &CurveGraph) -> Vec<CubicBezier> {
         g.edges()
@@ -579,11 +588,7 @@ mod tests {
     #[test]
     fn a_spike_tip_is_cut_where_it_is_one_width_wide() {
         let g = wedge(20.0, 30.0, 15.0, false);
-        let options = TipOptions {
-            width: 2.0,
-            reach: 2.0,
-            ..TipOptions::default()
-        };
+        let options = two_px();
         let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
         assert_eq!(b.tips, 1);
         assert!(b.graph.crossing().is_none());
@@ -676,11 +681,7 @@ mod tests {
     #[test]
     fn a_cut_that_would_be_sharp_itself_is_not_made() {
         let g = wedge(20.0, 30.0, 0.0, false);
-        let options = TipOptions {
-            width: 2.0,
-            reach: 2.0,
-            ..TipOptions::default()
-        };
+        let options = two_px();
         // As straight curves the tip is cut.
         assert!(blunt_sharp_tips(&g, &straight(&g), &options).is_some());
         let mut curves = straight(&g);

@@ -1397,8 +1397,8 @@ impl Pipeline {
         counts.opened_corners = corners.sharp;
         counts.turned_curves = corners.refitted;
         let curves: Vec<_> = fits.fits.iter().map(|f| f.curve).collect();
-        // Sharp tips the curves could not open are cut off where they are a quad side wide
-        // (uniform quads only).
+        // Sharp tips the curves could not open are cut off where they are one to two quad sides
+        // wide (uniform quads only).
         let tips = quad_size.filter(|_| !o.keep_sharp_tips).and_then(|q| {
             blunt_sharp_tips(
                 &simplified.graph,
