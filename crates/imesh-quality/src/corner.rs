@@ -47,8 +47,7 @@ pub fn sharpest_boundary_corner(
         .flat_map(|(i, (q, &label))| {
             (0..4).map(move |k| {
                 let (a, b) = (q[k], q[(k + 1) % 4]);
-                let edge = u64::from(a.min(b)) << 32 | u64::from(a.max(b));
-                (edge, label, (4 * i + k) as u32)
+                (crate::validate::edge_key(a, b), label, (4 * i + k) as u32)
             })
         })
         .collect();

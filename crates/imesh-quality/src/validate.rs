@@ -280,7 +280,7 @@ pub fn validate(mesh: &MeshView<'_>, domain: &Domain) -> ValidationReport {
                 });
             }
             let (a, b) = (c[k], c[(k + 1) % n]);
-            edges.push((u64::from(a.min(b)) << 32 | u64::from(a.max(b)), a < b));
+            edges.push((edge_key(a, b), a < b));
         }
         let mut polygon = [[0.0; 2]; 4];
         for (k, corner) in polygon.iter_mut().enumerate().take(n) {
@@ -352,6 +352,11 @@ fn check_edges(
             count => report.push(Violation::EdgeSharedTooOften { a, b, count }),
         }
     }
+}
+
+/// The undirected edge `a`–`b` as one sortable key: its smaller end, then its larger.
+pub(crate) fn edge_key(a: u32, b: u32) -> u64 {
+    u64::from(a.min(b)) << 32 | u64::from(a.max(b))
 }
 
 /// Shoelace signed area of a polygon (positive when counter-clockwise).
