@@ -8,6 +8,10 @@
 //! elements is to change the region there. Cutting the tip where it is a quad side wide gives
 //! the region two corners of 90° + θ/2 and its neighbour a triangle of about one quad's area
 //! whose corners are 90° − θ/2 and θ, the θ joining the neighbour's own corner at the vertex.
+//! A tip one of whose sides ends before it is a quad side wide (the region turns away there)
+//! is cut from that side's far vertex instead: its height over the other side is under a
+//! quad side, so a cut a quad side long meets the other side beyond its foot, at an angle
+//! of 30° or more for the neighbour and 150° or less for the region.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -70,7 +74,8 @@ struct End {
     edge: u32,
     /// The vertex is the edge's `ends[0]`.
     at_start: bool,
-    /// The far end's point.
+    /// The far end: its vertex and its point.
+    far_vertex: u32,
     far: Point,
     /// Directions (radians) of the chord and of the curve `reach` out.
     chord: f64,
@@ -98,8 +103,17 @@ struct Tip {
     receiver: u32,
     /// The narrower of the chord and curve sectors (radians).
     angle: f64,
-    /// Distance of the cut from the vertex along each chord.
-    depth: f64,
+    cut: CutAt,
+}
+
+/// Where a tip is cut.
+#[derive(Clone, Copy, Debug)]
+enum CutAt {
+    /// At a new vertex on each side, `depth` from the tip's vertex along both chords.
+    Across { depth: f64 },
+    /// From the far vertex of side `end`, too short for a cut across both sides, to a new
+    /// vertex `depth` along the other side's chord.
+    Through { end: usize, depth: f64 },
 }
 
 /// Cuts off every sector of G' narrower than `options.min_angle_deg` (the narrower of the
@@ -108,8 +122,11 @@ struct Tip {
 /// `options.max_depth` of those widths from the vertex): a new vertex on
 /// each of the two straight edges, a straight edge between them, and the triangle beyond given
 /// to the region across the first edge (the second's when the first is the domain's border).
-/// The curves are cut at the new vertices' projections, their ends moved onto them. A sector is
-/// left alone when one of its edges is too short to cut, already cut at its other end, or a
+/// The curves are cut at the new vertices' projections, their ends moved onto them. Where one
+/// edge is too short for that (the region turns away at its far vertex), the cut runs from
+/// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
+/// `options.min_angle_deg` or more, the short edge going to the receiver whole. A sector is
+/// left alone when no cut fits, when an edge is already cut at its other end, or when a
 /// vertex of the graph lies in the triangle. `None` when nothing was cut (or when two cuts
 /// would cross: then none is made).
 ///
@@ -159,9 +176,13 @@ pub fn blunt_sharp_tips(
             continue;
         }
         let v = g.point(tip.vertex);
-        let at = |e: &End| v + (e.far - v) * (tip.depth / norm(e.far - v));
-        let (p1, p2) = (at(&a), at(&b));
-        if !clear_triangle(g, tip.vertex, [v, p1, p2]) {
+        let at = |e: &End, depth: f64| v + (e.far - v) * (depth / norm(e.far - v));
+        let (p1, p2, kept) = match tip.cut {
+            CutAt::Across { depth } => (at(&a, depth), at(&b, depth), tip.vertex),
+            CutAt::Through { end: 0, depth } => (a.far, at(&b, depth), a.far_vertex),
+            CutAt::Through { depth, .. } => (at(&a, depth), b.far, b.far_vertex),
+        };
+        if !clear_triangle(g, [tip.vertex, kept], [v, p1, p2]) {
             continue;
         }
         used[a.edge as usize] = true;
@@ -175,12 +196,10 @@ pub fn blunt_sharp_tips(
         if cuts.is_empty() {
             return None;
         }
-        let blunted = cut_off(g, curves, &cuts)?;
-        let first_new = g.points().len() as u32;
+        let (blunted, ends) = cut_off(g, curves, &cuts)?;
         let sharp: Vec<usize> = (0..cuts.len())
             .filter(|&i| {
-                let ids = [first_new + 2 * i as u32, first_new + 2 * i as u32 + 1];
-                ids.iter().any(|&v| {
+                ends[i].iter().any(|&v| {
                     sectors(&blunted.graph, &blunted.curves, v, options.reach)
                         .iter()
                         .any(|s| s.angle < min)
@@ -196,19 +215,38 @@ pub fn blunt_sharp_tips(
     }
 }
 
-/// G' with the tips of `cuts` cut off (each with its two cut points, new vertices
-/// `n + 2i` and `n + 2i + 1` for `n` points in `g`); `None` if the graph would not be sound.
-fn cut_off(g: &CurveGraph, curves: &[CubicBezier], cuts: &[(Tip, [Point; 2])]) -> Option<Blunted> {
+/// G' with the tips of `cuts` cut off (each with its two cut points), and the vertices at
+/// the ends of each cut (new ones, or the far vertex of a side cut through); `None` if the
+/// graph would not be sound.
+fn cut_off(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    cuts: &[(Tip, [Point; 2])],
+) -> Option<(Blunted, Vec<[u32; 2]>)> {
     let mut points = g.points().to_vec();
     let mut replaced: Vec<Option<Vec<(GraphEdge, CubicBezier)>>> = vec![None; g.edges().len()];
     let mut added = Vec::new();
+    let mut cut_ends = Vec::with_capacity(cuts.len());
     let (mut area, mut moved) = (0.0, 0.0f64);
     for (tip, cut) in cuts {
-        let ids = [points.len() as u32, points.len() as u32 + 1];
-        points.extend(cut);
-        for (end, (&p, &id)) in tip.ends.iter().zip(cut.iter().zip(&ids)) {
-            replaced[end.edge as usize] = Some(split(g, curves, end, p, id, tip));
+        let through = match tip.cut {
+            CutAt::Through { end, .. } => Some(end),
+            CutAt::Across { .. } => None,
+        };
+        let mut ids = [0; 2];
+        for (k, (end, &p)) in tip.ends.iter().zip(cut).enumerate() {
+            let pieces = if through == Some(k) {
+                // The whole side is the tip's: it now bounds the receiver, if anything.
+                ids[k] = end.far_vertex;
+                relabelled(g, curves, end.edge, tip)
+            } else {
+                ids[k] = points.len() as u32;
+                points.push(p);
+                split(g, curves, end, p, ids[k], tip)
+            };
+            replaced[end.edge as usize] = Some(pieces);
         }
+        cut_ends.push(ids);
         let v = g.point(tip.vertex);
         let labels = if orient2d(cut[0], cut[1], v) > 0.0 {
             [tip.receiver, tip.region]
@@ -254,13 +292,14 @@ fn cut_off(g: &CurveGraph, curves: &[CubicBezier], cuts: &[(Tip, [Point; 2])]) -
     if graph.crossing().is_some() {
         return None;
     }
-    Some(Blunted {
+    let blunted = Blunted {
         graph,
         curves: new_curves,
         tips: cuts.len(),
         area,
         moved,
-    })
+    };
+    Some((blunted, cut_ends))
 }
 
 /// A sector of a vertex of G': from `ends[0]` counter-clockwise to `ends[1]`.
@@ -288,12 +327,14 @@ fn sectors(g: &CurveGraph, curves: &[CubicBezier], v: u32, reach: f64) -> Vec<Se
         .map(|&k| {
             let e = g.edges()[k as usize];
             let at_start = e.ends[0] == v;
-            let far = g.point(if at_start { e.ends[1] } else { e.ends[0] });
+            let far_vertex = if at_start { e.ends[1] } else { e.ends[0] };
+            let far = g.point(far_vertex);
             // The curve's direction as `open_sharp_corners` measures it.
             let out = chord(&curves[k as usize], at_start, reach).unwrap_or(far - p);
             End {
                 edge: k,
                 at_start,
+                far_vertex,
                 far,
                 chord: direction(far - p),
                 curve: direction(out),
@@ -343,24 +384,79 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             };
             // The widest cut its edges leave room for, down to `width`: a cut one quad wide
             // leaves the rest of a thin spike a quad wide too, a strip of half-size quads.
-            let cut = WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
+            let across = WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
                 let depth = (w / (2.0 * (chord / 2.0).sin())).min(options.max_depth * w);
                 let long_enough = |e: &End| norm(e.far - p) - depth >= 0.5 * options.width;
-                (depth.is_finite() && long_enough(&a) && long_enough(&b)).then_some(depth)
+                (depth.is_finite() && long_enough(&a) && long_enough(&b))
+                    .then_some(CutAt::Across { depth })
             });
-            if let Some(depth) = cut {
+            // A side too short for that: from its far vertex, the shorter side's first.
+            let shorter = usize::from(norm(b.far - p) < norm(a.far - p));
+            let cut = across.or_else(|| {
+                [shorter, 1 - shorter].into_iter().find_map(|end| {
+                    let depth = through_depth(p, &ends[end], &ends[1 - end], chord, options)?;
+                    Some(CutAt::Through { end, depth })
+                })
+            });
+            if let Some(cut) = cut {
                 tips.push(Tip {
                     vertex: v,
                     ends,
                     region,
                     receiver,
                     angle,
-                    depth,
+                    cut,
                 });
             }
         }
     }
     tips
+}
+
+/// How far along `long`'s chord a cut from the far vertex of `short` meets it, for the tip at
+/// `p` whose chords open by `chord` radians: the widest of [`WIDTHS`] for which the cut meets
+/// `long` at [`TipOptions::min_angle_deg`] or more beyond the foot of the far vertex (so that
+/// the region keeps at least 90° there), within `long` (leaving half a width of it) and
+/// within [`TipOptions::max_depth`] widths of `p`. `None` when no width fits.
+fn through_depth(
+    p: Point,
+    short: &End,
+    long: &End,
+    chord: f64,
+    options: &TipOptions,
+) -> Option<f64> {
+    let side = norm(short.far - p);
+    // The far vertex's foot on `long`'s line, and its height over it.
+    let (foot, height) = (side * chord.cos(), side * chord.sin());
+    let min = options.min_angle_deg.to_radians();
+    WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
+        let run = (w * w - height * height).sqrt();
+        let depth = foot + run;
+        (w >= height
+            && height.atan2(run) >= min
+            && depth <= norm(long.far - p) - 0.5 * options.width
+            && depth <= options.max_depth * w)
+            .then_some(depth)
+    })
+}
+
+/// `edge` whole, relabelled with the receiver for the region of `tip`, when it still
+/// separates two regions.
+fn relabelled(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    edge: u32,
+    tip: &Tip,
+) -> Vec<(GraphEdge, CubicBezier)> {
+    let e = g.edges()[edge as usize];
+    let labels = e
+        .labels
+        .map(|l| if l == tip.region { tip.receiver } else { l });
+    if labels[0] == labels[1] {
+        Vec::new()
+    } else {
+        vec![(GraphEdge { labels, ..e }, curves[edge as usize])]
+    }
 }
 
 /// The pieces of `end`'s edge once cut at `p` (new vertex `id`): the far piece with the
@@ -437,9 +533,9 @@ fn moved_end(c: CubicBezier, i: usize, p: Point) -> CubicBezier {
     CubicBezier::new(control)
 }
 
-/// True when no vertex of `g` but `v` lies in the closed triangle `t` (counter-clockwise or
-/// not).
-fn clear_triangle(g: &CurveGraph, v: u32, t: [Point; 3]) -> bool {
+/// True when no vertex of `g` but those of `corners` lies in the closed triangle `t`
+/// (counter-clockwise or not).
+fn clear_triangle(g: &CurveGraph, corners: [u32; 2], t: [Point; 3]) -> bool {
     let (lo, hi) = t.iter().fold(
         (
             Point::new(f64::INFINITY, f64::INFINITY),
@@ -454,7 +550,7 @@ fn clear_triangle(g: &CurveGraph, v: u32, t: [Point; 3]) -> bool {
     );
     let sign = orient2d(t[0], t[1], t[2]).signum();
     g.points().iter().enumerate().all(|(u, &q)| {
-        u as u32 == v
+        corners.contains(&(u as u32))
             || q.x < lo.x
             || q.x > hi.x
             || q.y < lo.y
@@ -693,6 +789,76 @@ mod tests {
         assert!(blunt_sharp_tips(&g, &curves, &options).is_none());
     }
 
+    /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
+    /// `long` px along the x axis, its upper side `short` px long, from whose end `a` (vertex 4)
+    /// the region's boundary turns straight up; region 0 around it, in a square frame.
+    fn hook(angle: f64, short: f64, long: f64, turn: f64) -> CurveGraph {
+        let (sin, cos) = turn.to_radians().sin_cos();
+        let at = |x: f64, y: f64| Point::new(x * cos - y * sin, x * sin + y * cos);
+        let a = angle.to_radians();
+        let (ax, ay, top, s) = (short * a.cos(), short * a.sin(), long, 3.0 * long);
+        let points = vec![
+            at(0.0, 0.0),
+            at(long, 0.0),
+            at(long, top),
+            at(ax, top),
+            at(ax, ay),
+            at(-s, -s),
+            at(s, -s),
+            at(s, s),
+            at(-s, s),
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let edges = vec![
+            e(0, 1, [1, 0]),
+            e(1, 2, [1, 0]),
+            e(2, 3, [1, 0]),
+            e(3, 4, [1, 0]),
+            e(4, 0, [1, 0]),
+            e(5, 6, [0, OUTSIDE]),
+            e(6, 7, [0, OUTSIDE]),
+            e(7, 8, [0, OUTSIDE]),
+            e(8, 5, [0, OUTSIDE]),
+        ];
+        CurveGraph::new(points, edges).unwrap()
+    }
+
+    /// A 20° tip whose upper side ends 3 px out, where the region turns up: too short for a
+    /// cut across both sides, it is cut from that side's end to the lower side, one width
+    /// (2 px) long, the short side and the triangle given to region 0.
+    #[test]
+    fn a_tip_with_a_short_side_is_cut_from_its_end() {
+        let g = hook(20.0, 3.0, 30.0, 35.0);
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        // One new vertex; the cut joins it to the short side's end, vertex 4.
+        assert_eq!(b.graph.points().len(), g.points().len() + 1);
+        let cut = b.graph.edges().last().unwrap();
+        let new = g.points().len() as u32;
+        assert!(cut.ends.contains(&4) && cut.ends.contains(&new));
+        let [p, q] = cut.ends.map(|v| b.graph.point(v));
+        assert!((norm(q - p) - 2.0).abs() < 1e-9);
+        // Region 1 keeps more than 90° at the new vertex, region 0 gets 30° or more there.
+        for (label, angle) in sectors_at(&b.graph, new) {
+            assert!(
+                angle >= if label == 1 { 90.0 } else { 30.0 },
+                "{label}: {angle}"
+            );
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+        // The triangle: the 3 px side and the 4.5 px run to the cut, at 20°.
+        let run = 3.0 * 20f64.to_radians().cos()
+            + (4.0 - (3.0 * 20f64.to_radians().sin()).powi(2)).sqrt();
+        assert!((b.area - 0.5 * 3.0 * run * 20f64.to_radians().sin()).abs() < 1e-9);
+    }
+
     /// Nothing to cut: a sector of 40°, and a 20° tip whose sides are too short.
     #[test]
     fn wide_or_short_tips_are_left() {
@@ -728,6 +894,38 @@ mod tests {
                         if label == 1 {
                             prop_assert!(a >= 90.0 - 1e-6, "{}", a);
                         }
+                    }
+                }
+            }
+        }
+
+        /// Any tip of 3–29° whose one side ends early, where the region turns away: the graph
+        /// stays planar with consistent faces, the area moves only from the region to its
+        /// neighbour, and every corner at the cut's ends is 30° or more (the region's at the
+        /// new vertex 90° or more).
+        #[test]
+        fn tips_cut_from_a_short_side_keep_the_graph_sound(
+            angle in 3.0f64..29.0,
+            short in 0.5f64..12.0,
+            long in 10.0f64..60.0,
+            turn in -180.0f64..180.0,
+            width in 0.5f64..4.0,
+        ) {
+            let g = hook(angle, short, long, turn);
+            let options = TipOptions { width, reach: width, ..TipOptions::default() };
+            if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
+                prop_assert!(b.graph.crossing().is_none());
+                let (before, after) = (areas(&g), areas(&b.graph));
+                let scale = long * long;
+                prop_assert!(b.area > 0.0);
+                prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
+                prop_assert!((after[&0] - before[&0] - b.area).abs() < 1e-9 * scale);
+                let cut = b.graph.edges().last().unwrap();
+                for v in cut.ends {
+                    let new = v as usize >= g.points().len();
+                    for (label, a) in sectors_at(&b.graph, v) {
+                        let least = if label == 1 && new { 90.0 } else { 30.0 };
+                        prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
                     }
                 }
             }

@@ -116,11 +116,13 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             r.label_agreement
         );
         // A corner between two boundary edges fills a sector alone: its sine bounds the worst
-        // scaled Jacobian; on all fixtures but one the worst is either such a corner, where the
+        // scaled Jacobian; on all fixtures but two the worst is either such a corner, where the
         // curves could not be turned wider within the tolerance nor the tip cut, or at the
         // repair's bar of 0.5 (coffee's, in a strip a pixel wide, since refinement leaves such
         // strips alone). Gravel's worst, 0.484 once its tips are cut (0.459 at a 27° corner
-        // before), is a quad of a strip 1.5 px wide along the border, under its 29.6° corner.
+        // before), is a quad of a strip 1.5 px wide along the border, under its 29.6° corner;
+        // grass's, 0.476 once its tips with a short side are cut from that side's end (0.447
+        // at a 27° corner before), a quad of a gap 1.2 px wide between two regions.
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -145,6 +147,11 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
                 path.display(),
                 r.quality.scaled_jacobian().min
             );
+        }
+        if path.ends_with("skimage-grass.png") {
+            // Its 26.6° tip, whose shorter side ends 3 px out, is cut from that side's end.
+            assert!(r.counts.blunted_tips > 0);
+            assert!(worst > 0.47, "grass: worst scaled Jacobian {worst}");
         }
         if path.ends_with("skimage-brick.png") {
             // Simplified, boundaries met the border and each other at 8–15°; the boundaries'
@@ -171,7 +178,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_a_bound >= 9, "{at_a_bound}");
+    assert!(at_a_bound >= 8, "{at_a_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
