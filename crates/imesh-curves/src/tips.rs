@@ -11,7 +11,8 @@
 //! A tip one of whose sides ends before it is a quad side wide (the region turns away there)
 //! is cut from that side's far vertex instead: its height over the other side is under a
 //! quad side, so a cut a quad side long meets the other side beyond its foot, at an angle
-//! of 30° or more for the neighbour and 150° or less for the region.
+//! of 30° or more for the neighbour and 150° or less for the region; a tip both of whose
+//! sides end that early, between their ends.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -114,6 +115,8 @@ enum CutAt {
     /// From the far vertex of side `end`, too short for a cut across both sides, to a new
     /// vertex `depth` along the other side's chord.
     Through { end: usize, depth: f64 },
+    /// Between the far vertices of both sides, too short for either cut.
+    Whole,
 }
 
 /// Cuts off every sector of G' narrower than `options.min_angle_deg` (the narrower of the
@@ -125,9 +128,10 @@ enum CutAt {
 /// The curves are cut at the new vertices' projections, their ends moved onto them. Where one
 /// edge is too short for that (the region turns away at its far vertex), the cut runs from
 /// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
-/// `options.min_angle_deg` or more, the short edge going to the receiver whole. A sector is
-/// left alone when no cut fits, when an edge is already cut at its other end, or when a
-/// vertex of the graph lies in the triangle. `None` when nothing was cut (or when two cuts
+/// `options.min_angle_deg` or more, the short edge going to the receiver whole; where both
+/// are, between their far vertices if those are a width or more apart. A sector is left
+/// alone when no cut fits, when an edge is already cut at its other end, or when a vertex
+/// of the graph lies in the triangle. `None` when nothing was cut (or when two cuts
 /// would cross: then none is made).
 ///
 /// ```
@@ -178,11 +182,12 @@ pub fn blunt_sharp_tips(
         let v = g.point(tip.vertex);
         let at = |e: &End, depth: f64| v + (e.far - v) * (depth / norm(e.far - v));
         let (p1, p2, kept) = match tip.cut {
-            CutAt::Across { depth } => (at(&a, depth), at(&b, depth), tip.vertex),
-            CutAt::Through { end: 0, depth } => (a.far, at(&b, depth), a.far_vertex),
-            CutAt::Through { depth, .. } => (at(&a, depth), b.far, b.far_vertex),
+            CutAt::Across { depth } => (at(&a, depth), at(&b, depth), [tip.vertex; 2]),
+            CutAt::Through { end: 0, depth } => (a.far, at(&b, depth), [a.far_vertex; 2]),
+            CutAt::Through { depth, .. } => (at(&a, depth), b.far, [b.far_vertex; 2]),
+            CutAt::Whole => (a.far, b.far, [a.far_vertex, b.far_vertex]),
         };
-        if !clear_triangle(g, [tip.vertex, kept], [v, p1, p2]) {
+        if !clear_triangle(g, [tip.vertex, kept[0], kept[1]], [v, p1, p2]) {
             continue;
         }
         used[a.edge as usize] = true;
@@ -229,13 +234,14 @@ fn cut_off(
     let mut cut_ends = Vec::with_capacity(cuts.len());
     let (mut area, mut moved) = (0.0, 0.0f64);
     for (tip, cut) in cuts {
-        let through = match tip.cut {
-            CutAt::Through { end, .. } => Some(end),
-            CutAt::Across { .. } => None,
+        let through = |k: usize| match tip.cut {
+            CutAt::Through { end, .. } => end == k,
+            CutAt::Whole => true,
+            CutAt::Across { .. } => false,
         };
         let mut ids = [0; 2];
         for (k, (end, &p)) in tip.ends.iter().zip(cut).enumerate() {
-            let pieces = if through == Some(k) {
+            let pieces = if through(k) {
                 // The whole side is the tip's: it now bounds the receiver, if anything.
                 ids[k] = end.far_vertex;
                 relabelled(g, curves, end.edge, tip)
@@ -392,12 +398,26 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             });
             // A side too short for that: from its far vertex, the shorter side's first.
             let shorter = usize::from(norm(b.far - p) < norm(a.far - p));
-            let cut = across.or_else(|| {
+            let through = || {
                 [shorter, 1 - shorter].into_iter().find_map(|end| {
                     let depth = through_depth(p, &ends[end], &ends[1 - end], chord, options)?;
                     Some(CutAt::Through { end, depth })
                 })
-            });
+            };
+            // Both too short: between their far vertices, if that is a width or more across,
+            // within the deepest cut, and not already an edge (the region a triangle).
+            let whole = || {
+                let across = norm(b.far - a.far);
+                let depth = cross(a.far - p, b.far - p).abs() / across;
+                (across >= options.width
+                    && depth <= options.max_depth * options.width
+                    && !g
+                        .incident(a.far_vertex)
+                        .iter()
+                        .any(|&k| g.edges()[k as usize].ends.contains(&b.far_vertex)))
+                .then_some(CutAt::Whole)
+            };
+            let cut = across.or_else(through).or_else(whole);
             if let Some(cut) = cut {
                 tips.push(Tip {
                     vertex: v,
@@ -535,7 +555,7 @@ fn moved_end(c: CubicBezier, i: usize, p: Point) -> CubicBezier {
 
 /// True when no vertex of `g` but those of `corners` lies in the closed triangle `t`
 /// (counter-clockwise or not).
-fn clear_triangle(g: &CurveGraph, corners: [u32; 2], t: [Point; 3]) -> bool {
+fn clear_triangle(g: &CurveGraph, corners: [u32; 3], t: [Point; 3]) -> bool {
     let (lo, hi) = t.iter().fold(
         (
             Point::new(f64::INFINITY, f64::INFINITY),
@@ -859,6 +879,63 @@ mod tests {
         assert!((b.area - 0.5 * 3.0 * run * 20f64.to_radians().sin()).abs() < 1e-9);
     }
 
+    /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
+    /// `lower` px along the x axis to vertex 1, its upper side `upper` px long to vertex 6, the
+    /// region turning away from the tip at both (outwards at 45°), then closed far off;
+    /// region 0 around it, in a square frame.
+    fn spike(angle: f64, upper: f64, lower: f64, turn: f64) -> CurveGraph {
+        let (sin, cos) = turn.to_radians().sin_cos();
+        let at = |x: f64, y: f64| Point::new(x * cos - y * sin, x * sin + y * cos);
+        let a = angle.to_radians();
+        let (ax, ay) = (upper * a.cos(), upper * a.sin());
+        let (far, top) = (upper.max(lower) + 15.0, ay + 13.0);
+        let s = 3.0 * far;
+        let points = vec![
+            at(0.0, 0.0),
+            at(lower, 0.0),
+            at(lower + 3.0, -3.0),
+            at(far, -3.0),
+            at(far, top),
+            at(ax - 3.0, ay + 3.0),
+            at(ax, ay),
+            at(-s, -s),
+            at(s, -s),
+            at(s, s),
+            at(-s, s),
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let mut edges: Vec<GraphEdge> = (0..7).map(|k| e(k, (k + 1) % 7, [1, 0])).collect();
+        edges.extend((7..11).map(|k| e(k, 7 + (k - 6) % 4, [0, OUTSIDE])));
+        CurveGraph::new(points, edges).unwrap()
+    }
+
+    /// A 25° spike both of whose sides end 5 px out (2.5 widths), where the region turns away:
+    /// too short for a cut across both or from either end, it is cut between their ends, 2.2
+    /// px apart, and the triangle given to region 0.
+    #[test]
+    fn a_tip_with_two_short_sides_is_cut_between_their_ends() {
+        let g = spike(25.0, 5.0, 5.0, -70.0);
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        assert_eq!(b.graph.points().len(), g.points().len());
+        let cut = b.graph.edges().last().unwrap();
+        assert!(cut.ends.contains(&1) && cut.ends.contains(&6));
+        for v in cut.ends {
+            for (label, angle) in sectors_at(&b.graph, v) {
+                assert!(angle >= 30.0, "{label} at {v}: {angle}");
+            }
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+        assert!((b.area - 0.5 * 25.0 * 25f64.to_radians().sin()).abs() < 1e-9);
+    }
+
     /// Nothing to cut: a sector of 40°, and a 20° tip whose sides are too short.
     #[test]
     fn wide_or_short_tips_are_left() {
@@ -899,19 +976,24 @@ mod tests {
             }
         }
 
-        /// Any tip of 3–29° whose one side ends early, where the region turns away: the graph
-        /// stays planar with consistent faces, the area moves only from the region to its
-        /// neighbour, and every corner at the cut's ends is 30° or more (the region's at the
-        /// new vertex 90° or more).
+        /// Any tip of 3–29° whose one side ends early, where the region turns away, or both
+        /// (a spike): the graph stays planar with consistent faces, the area moves only from
+        /// the region to its neighbour, and every corner at the cut's ends is 30° or more (the
+        /// region's at a new vertex 90° or more).
         #[test]
         fn tips_cut_from_a_short_side_keep_the_graph_sound(
             angle in 3.0f64..29.0,
             short in 0.5f64..12.0,
-            long in 10.0f64..60.0,
+            long in 0.5f64..60.0,
             turn in -180.0f64..180.0,
             width in 0.5f64..4.0,
+            both_short: bool,
         ) {
-            let g = hook(angle, short, long, turn);
+            let g = if both_short {
+                spike(angle, short, long.min(12.0), turn)
+            } else {
+                hook(angle, short, long.max(10.0), turn)
+            };
             let options = TipOptions { width, reach: width, ..TipOptions::default() };
             if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
                 prop_assert!(b.graph.crossing().is_none());
