@@ -12,7 +12,8 @@
 //! is cut from that side's far vertex instead: its height over the other side is under a
 //! quad side, so a cut a quad side long meets the other side beyond its foot, at an angle
 //! of 30° or more for the neighbour and 150° or less for the region; a tip both of whose
-//! sides end that early, between their ends.
+//! sides end that early, between their ends; and a spike that stays narrow one vertex further
+//! (a pixel staircase), from that vertex.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -100,23 +101,64 @@ impl End {
 struct Tip {
     vertex: u32,
     ends: [End; 2],
+    /// Per side, the region's next boundary edge, from the far vertex of the first.
+    next: [Option<End>; 2],
     region: u32,
     receiver: u32,
     /// The narrower of the chord and curve sectors (radians).
     angle: f64,
-    cut: CutAt,
+    /// Where the cut meets each side.
+    cut: [CutEnd; 2],
 }
 
-/// Where a tip is cut.
-#[derive(Clone, Copy, Debug)]
-enum CutAt {
-    /// At a new vertex on each side, `depth` from the tip's vertex along both chords.
-    Across { depth: f64 },
-    /// From the far vertex of side `end`, too short for a cut across both sides, to a new
-    /// vertex `depth` along the other side's chord.
-    Through { end: usize, depth: f64 },
-    /// Between the far vertices of both sides, too short for either cut.
-    Whole,
+/// Where a tip's cut meets one of its sides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum CutEnd {
+    /// At a new vertex this far from the tip's vertex along the side's first chord.
+    Along(f64),
+    /// At the far vertex of the side's first edge.
+    First,
+    /// At the far vertex of the next edge along the region's boundary.
+    Second,
+}
+
+impl Tip {
+    /// The edges the cut takes in part or whole.
+    fn edges(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..2).flat_map(move |k| {
+            let second = (self.cut[k] == CutEnd::Second)
+                .then_some(self.next[k])
+                .flatten();
+            std::iter::once(self.ends[k].edge).chain(second.map(|e| e.edge))
+        })
+    }
+
+    /// The piece cut off: its outline (the tip's vertex, side 0 out to the cut, side 1 back),
+    /// the indices in it of the cut's two ends, and the vertices of the graph on it.
+    fn piece(&self, g: &CurveGraph) -> (Vec<Point>, [usize; 2], Vec<u32>) {
+        let v = g.point(self.vertex);
+        let mut ids = vec![self.vertex];
+        let side = |k: usize, ids: &mut Vec<u32>| -> Vec<Point> {
+            let e = &self.ends[k];
+            match (self.cut[k], self.next[k]) {
+                (CutEnd::Along(depth), _) => vec![v + (e.far - v) * (depth / norm(e.far - v))],
+                (CutEnd::First, _) | (CutEnd::Second, None) => {
+                    ids.push(e.far_vertex);
+                    vec![e.far]
+                }
+                (CutEnd::Second, Some(n)) => {
+                    ids.extend([e.far_vertex, n.far_vertex]);
+                    vec![e.far, n.far]
+                }
+            }
+        };
+        let out = side(0, &mut ids);
+        let mut back = side(1, &mut ids);
+        back.reverse();
+        let ends = [out.len(), out.len() + 1];
+        let outline = std::iter::once(v).chain(out).chain(back).collect();
+        (outline, ends, ids)
+    }
 }
 
 /// Cuts off every sector of G' narrower than `options.min_angle_deg` (the narrower of the
@@ -129,10 +171,11 @@ enum CutAt {
 /// edge is too short for that (the region turns away at its far vertex), the cut runs from
 /// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
 /// `options.min_angle_deg` or more, the short edge going to the receiver whole; where both
-/// are, between their far vertices if those are a width or more apart. A sector is left
-/// alone when no cut fits, when an edge is already cut at its other end, or when a vertex
-/// of the graph lies in the triangle. `None` when nothing was cut (or when two cuts
-/// would cross: then none is made).
+/// are, between their far vertices if those are a width or more apart; failing those, the
+/// same from the next vertex along the region's boundary on either side (a staircase spike),
+/// the cut then at most two widths long. A sector is left alone when no cut fits, when an
+/// edge is already cut at its other end, or when a vertex of the graph lies in the piece cut
+/// off; cuts whose edges would cross are dropped. `None` when nothing was cut.
 ///
 /// ```
 /// use imesh_curves::{blunt_sharp_tips, CubicBezier, CurveGraph, GraphEdge, TipOptions};
@@ -175,24 +218,17 @@ pub fn blunt_sharp_tips(
     let mut used = vec![false; g.edges().len()];
     let mut cuts = Vec::new();
     for tip in tips {
-        let [a, b] = tip.ends;
-        if used[a.edge as usize] || used[b.edge as usize] {
+        if tip.edges().any(|e| used[e as usize]) {
             continue;
         }
-        let v = g.point(tip.vertex);
-        let at = |e: &End, depth: f64| v + (e.far - v) * (depth / norm(e.far - v));
-        let (p1, p2, kept) = match tip.cut {
-            CutAt::Across { depth } => (at(&a, depth), at(&b, depth), [tip.vertex; 2]),
-            CutAt::Through { end: 0, depth } => (a.far, at(&b, depth), [a.far_vertex; 2]),
-            CutAt::Through { depth, .. } => (at(&a, depth), b.far, [b.far_vertex; 2]),
-            CutAt::Whole => (a.far, b.far, [a.far_vertex, b.far_vertex]),
-        };
-        if !clear_triangle(g, [tip.vertex, kept[0], kept[1]], [v, p1, p2]) {
+        let (outline, [i, j], on) = tip.piece(g);
+        if !sound_piece(g, &on, &outline, [i, j]) {
             continue;
         }
-        used[a.edge as usize] = true;
-        used[b.edge as usize] = true;
-        cuts.push((tip, [p1, p2]));
+        for e in tip.edges() {
+            used[e as usize] = true;
+        }
+        cuts.push((tip, [outline[i], outline[j]]));
     }
     // A cut whose new corners would be sharp themselves (a curve turning back across its
     // chord near the cut) is dropped, and the rest made again.
@@ -201,7 +237,18 @@ pub fn blunt_sharp_tips(
         if cuts.is_empty() {
             return None;
         }
-        let (blunted, ends) = cut_off(g, curves, &cuts)?;
+        let (blunted, ends) = match cut_off(g, curves, &cuts) {
+            Ok(made) => made,
+            // Two tips of one region folded onto each other can overlap: the cuts whose edges
+            // cross are dropped, and the rest made again.
+            Err(crossing) if !crossing.is_empty() => {
+                for &i in crossing.iter().rev() {
+                    cuts.remove(i);
+                }
+                continue;
+            }
+            Err(_) => return None,
+        };
         let sharp: Vec<usize> = (0..cuts.len())
             .filter(|&i| {
                 ends[i].iter().any(|&v| {
@@ -221,82 +268,106 @@ pub fn blunt_sharp_tips(
 }
 
 /// G' with the tips of `cuts` cut off (each with its two cut points), and the vertices at
-/// the ends of each cut (new ones, or the far vertex of a side cut through); `None` if the
-/// graph would not be sound.
+/// the ends of each cut (new ones, or the far vertex of a side cut through). When the graph
+/// would cross itself, the cuts whose edges cross (in increasing order); no cut when it would
+/// not be sound otherwise.
 fn cut_off(
     g: &CurveGraph,
     curves: &[CubicBezier],
     cuts: &[(Tip, [Point; 2])],
-) -> Option<(Blunted, Vec<[u32; 2]>)> {
+) -> Result<(Blunted, Vec<[u32; 2]>), Vec<usize>> {
     let mut points = g.points().to_vec();
     let mut replaced: Vec<Option<Vec<(GraphEdge, CubicBezier)>>> = vec![None; g.edges().len()];
+    // The cut each edge of `g` belongs to, once cut.
+    let mut cut_of = vec![usize::MAX; g.edges().len()];
     let mut added = Vec::new();
     let mut cut_ends = Vec::with_capacity(cuts.len());
     let (mut area, mut moved) = (0.0, 0.0f64);
-    for (tip, cut) in cuts {
-        let through = |k: usize| match tip.cut {
-            CutAt::Through { end, .. } => end == k,
-            CutAt::Whole => true,
-            CutAt::Across { .. } => false,
-        };
+    for (i, (tip, cut)) in cuts.iter().enumerate() {
+        for e in tip.edges() {
+            cut_of[e as usize] = i;
+        }
         let mut ids = [0; 2];
         for (k, (end, &p)) in tip.ends.iter().zip(cut).enumerate() {
-            let pieces = if through(k) {
-                // The whole side is the tip's: it now bounds the receiver, if anything.
-                ids[k] = end.far_vertex;
-                relabelled(g, curves, end.edge, tip)
-            } else {
-                ids[k] = points.len() as u32;
-                points.push(p);
-                split(g, curves, end, p, ids[k], tip)
-            };
-            replaced[end.edge as usize] = Some(pieces);
+            // A side taken whole now bounds the receiver, if anything.
+            let whole = |e: &End| Some(relabelled(g, curves, e.edge, tip));
+            match (tip.cut[k], tip.next[k]) {
+                (CutEnd::Along(_), _) => {
+                    ids[k] = points.len() as u32;
+                    points.push(p);
+                    replaced[end.edge as usize] = Some(split(g, curves, end, p, ids[k], tip));
+                }
+                (CutEnd::Second, Some(n)) => {
+                    ids[k] = n.far_vertex;
+                    replaced[end.edge as usize] = whole(end);
+                    replaced[n.edge as usize] = whole(&n);
+                }
+                (CutEnd::First | CutEnd::Second, _) => {
+                    ids[k] = end.far_vertex;
+                    replaced[end.edge as usize] = whole(end);
+                }
+            }
         }
         cut_ends.push(ids);
-        let v = g.point(tip.vertex);
-        let labels = if orient2d(cut[0], cut[1], v) > 0.0 {
-            [tip.receiver, tip.region]
-        } else {
-            [tip.region, tip.receiver]
-        };
+        // The piece is counter-clockwise, its cut walked from side 0 to side 1: the piece, now
+        // the receiver's, on the cut's left.
+        let (outline, _, _) = tip.piece(g);
         added.push((
-            GraphEdge { ends: ids, labels },
+            GraphEdge {
+                ends: ids,
+                labels: [tip.receiver, tip.region],
+            },
             CubicBezier::segment(cut[0], cut[1]),
         ));
-        let twice_area = cross(cut[0] - v, cut[1] - v).abs();
-        area += 0.5 * twice_area;
-        moved = moved.max(twice_area / norm(cut[1] - cut[0]));
+        area += polygon_area(&outline).abs();
+        // The farthest the boundary moved: its farthest vertex cut off from the cut's line.
+        let across = cut[1] - cut[0];
+        for &q in &outline {
+            moved = moved.max(cross(across, q - cut[0]).abs() / norm(across));
+        }
     }
     let mut edges = Vec::with_capacity(g.edges().len() + 2 * cuts.len());
     let mut new_curves = Vec::with_capacity(edges.capacity());
+    // The cut each new edge belongs to (usize::MAX for none).
+    let mut owner = Vec::with_capacity(edges.capacity());
     for (k, e) in g.edges().iter().enumerate() {
         match &replaced[k] {
             Some(pieces) => {
                 for &(piece, curve) in pieces {
                     edges.push(piece);
                     new_curves.push(curve);
+                    owner.push(cut_of[k]);
                 }
             }
             None => {
                 edges.push(*e);
                 new_curves.push(curves[k]);
+                owner.push(usize::MAX);
             }
         }
     }
-    for (e, c) in added {
+    for (i, (e, c)) in added.into_iter().enumerate() {
         edges.push(e);
         new_curves.push(c);
+        owner.push(i);
     }
-    let mut graph = CurveGraph::new(points, edges).ok()?;
+    let mut graph = CurveGraph::new(points, edges).map_err(|_| Vec::new())?;
     for v in 0..g.points().len() as u32 {
         if g.is_pinned(v) {
-            graph.pin(v).ok()?;
+            graph.pin(v).map_err(|_| Vec::new())?;
         }
     }
-    // Each cut lies in its own tip, which holds no vertex; two tips of one region folded onto
-    // each other could still overlap: then nothing is cut rather than a graph that crosses.
-    if graph.crossing().is_some() {
-        return None;
+    // Each cut lies in its own piece, which holds no vertex; two tips of one region folded
+    // onto each other could still overlap.
+    if let Some(pair) = graph.crossing() {
+        let mut crossing: Vec<usize> = pair
+            .iter()
+            .map(|&e| owner[e as usize])
+            .filter(|&i| i != usize::MAX)
+            .collect();
+        crossing.sort_unstable();
+        crossing.dedup();
+        return Err(crossing);
     }
     let blunted = Blunted {
         graph,
@@ -305,7 +376,7 @@ fn cut_off(
         area,
         moved,
     };
-    Some((blunted, cut_ends))
+    Ok((blunted, cut_ends))
 }
 
 /// A sector of a vertex of G': from `ends[0]` counter-clockwise to `ends[1]`.
@@ -388,40 +459,75 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
                 (_, s) if s != OUTSIDE && s != region => s,
                 _ => continue,
             };
+            // The region's boundary one edge further on each side (not back at the tip).
+            let next = [0, 1].map(|k| {
+                let e = ends[k];
+                let n = sectors(g, curves, e.far_vertex, options.reach)
+                    .into_iter()
+                    .find(|s| s.ends[1 - k].edge == e.edge)
+                    .map(|s| s.ends[k])?;
+                (n.edge != e.edge && n.far_vertex != v).then_some(n)
+            });
+            let far = |k: usize, at: CutEnd| match (at, next[k]) {
+                (CutEnd::First, _) => Some(ends[k].far),
+                (CutEnd::Second, Some(n)) => Some(n.far),
+                _ => None,
+            };
             // The widest cut its edges leave room for, down to `width`: a cut one quad wide
             // leaves the rest of a thin spike a quad wide too, a strip of half-size quads.
-            let across = WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
-                let depth = (w / (2.0 * (chord / 2.0).sin())).min(options.max_depth * w);
-                let long_enough = |e: &End| norm(e.far - p) - depth >= 0.5 * options.width;
-                (depth.is_finite() && long_enough(&a) && long_enough(&b))
-                    .then_some(CutAt::Across { depth })
-            });
-            // A side too short for that: from its far vertex, the shorter side's first.
-            let shorter = usize::from(norm(b.far - p) < norm(a.far - p));
-            let through = || {
-                [shorter, 1 - shorter].into_iter().find_map(|end| {
-                    let depth = through_depth(p, &ends[end], &ends[1 - end], chord, options)?;
-                    Some(CutAt::Through { end, depth })
+            let across = || {
+                WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
+                    let depth = (w / (2.0 * (chord / 2.0).sin())).min(options.max_depth * w);
+                    let long_enough = |e: &End| norm(e.far - p) - depth >= 0.5 * options.width;
+                    (depth.is_finite() && long_enough(&a) && long_enough(&b))
+                        .then_some([CutEnd::Along(depth); 2])
                 })
             };
-            // Both too short: between their far vertices, if that is a width or more across,
-            // within the deepest cut, and not already an edge (the region a triangle).
-            let whole = || {
-                let across = norm(b.far - a.far);
-                let depth = cross(a.far - p, b.far - p).abs() / across;
+            // A side too short for that: from its far vertex (the shorter side's first), then
+            // from the next vertex along the region's boundary, to the other side.
+            let shorter = usize::from(norm(b.far - p) < norm(a.far - p));
+            let through = |at: CutEnd| {
+                [shorter, 1 - shorter].into_iter().find_map(|k| {
+                    let depth = through_depth(p, far(k, at)?, &ends[1 - k], k == 0, options)?;
+                    let mut cut = [CutEnd::Along(depth); 2];
+                    cut[k] = at;
+                    Some(cut)
+                })
+            };
+            // Both too short: between the vertices where the sides end, if they are a width
+            // or more apart (and at most two beyond the tip's first vertices), within the
+            // deepest cut, and not already joined by an edge.
+            let whole = |at: [CutEnd; 2]| {
+                let (qa, qb) = (far(0, at[0])?, far(1, at[1])?);
+                let across = norm(qb - qa);
+                let depth = cross(qa - p, qb - p).abs() / across;
+                let ids = [0, 1].map(|k| match at[k] {
+                    CutEnd::Second => next[k].map_or(u32::MAX, |n| n.far_vertex),
+                    _ => ends[k].far_vertex,
+                });
+                let first = at == [CutEnd::First; 2];
                 (across >= options.width
+                    && (first || across <= WIDTHS[0] * options.width)
                     && depth <= options.max_depth * options.width
                     && !g
-                        .incident(a.far_vertex)
+                        .incident(ids[0])
                         .iter()
-                        .any(|&k| g.edges()[k as usize].ends.contains(&b.far_vertex)))
-                .then_some(CutAt::Whole)
+                        .any(|&k| g.edges()[k as usize].ends.contains(&ids[1])))
+                .then_some(at)
             };
-            let cut = across.or_else(through).or_else(whole);
+            let (first, second) = (CutEnd::First, CutEnd::Second);
+            let cut = across()
+                .or_else(|| through(first))
+                .or_else(|| whole([first; 2]))
+                .or_else(|| through(second))
+                .or_else(|| whole([second, first]))
+                .or_else(|| whole([first, second]))
+                .or_else(|| whole([second; 2]));
             if let Some(cut) = cut {
                 tips.push(Tip {
                     vertex: v,
                     ends,
+                    next,
                     region,
                     receiver,
                     angle,
@@ -433,21 +539,21 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
     tips
 }
 
-/// How far along `long`'s chord a cut from the far vertex of `short` meets it, for the tip at
-/// `p` whose chords open by `chord` radians: the widest of [`WIDTHS`] for which the cut meets
-/// `long` at [`TipOptions::min_angle_deg`] or more beyond the foot of the far vertex (so that
-/// the region keeps at least 90° there), within `long` (leaving half a width of it) and
-/// within [`TipOptions::max_depth`] widths of `p`. `None` when no width fits.
-fn through_depth(
-    p: Point,
-    short: &End,
-    long: &End,
-    chord: f64,
-    options: &TipOptions,
-) -> Option<f64> {
-    let side = norm(short.far - p);
-    // The far vertex's foot on `long`'s line, and its height over it.
-    let (foot, height) = (side * chord.cos(), side * chord.sin());
+/// How far along `long`'s chord a cut from `q`, a vertex on the tip's other side, meets it,
+/// for the tip at `p` (the region on the left of `long`, or on its right when `right`): the
+/// widest of [`WIDTHS`] for which the cut meets `long` at [`TipOptions::min_angle_deg`] or
+/// more beyond the foot of `q` (so that the region keeps at least 90° there), within `long`
+/// (leaving half a width of it) and within [`TipOptions::max_depth`] widths of `p`. `None`
+/// when no width fits, or when `q` is not on the region's side of `long`.
+fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptions) -> Option<f64> {
+    let along = (long.far - p) * (1.0 / norm(long.far - p));
+    // `q`'s foot on `long`'s line, and its height over it on the region's side.
+    let (foot, height) = (dot(along, q - p), cross(along, q - p));
+    let height = if right { -height } else { height };
+    // A NaN height (a degenerate side) fails too.
+    if height.is_nan() || height <= 0.0 {
+        return None;
+    }
     let min = options.min_angle_deg.to_radians();
     WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
         let run = (w * w - height * height).sqrt();
@@ -553,10 +659,24 @@ fn moved_end(c: CubicBezier, i: usize, p: Point) -> CubicBezier {
     CubicBezier::new(control)
 }
 
-/// True when no vertex of `g` but those of `corners` lies in the closed triangle `t`
-/// (counter-clockwise or not).
-fn clear_triangle(g: &CurveGraph, corners: [u32; 3], t: [Point; 3]) -> bool {
-    let (lo, hi) = t.iter().fold(
+/// True when the piece `outline` (counter-clockwise, its cut from `outline[cut[0]]` to
+/// `outline[cut[1]]`, its other sides edges of `g`) is a simple polygon the cut does not leave,
+/// and no vertex of `g` but those of `on` lies in it or on its outline.
+fn sound_piece(g: &CurveGraph, on: &[u32], outline: &[Point], cut: [usize; 2]) -> bool {
+    let n = outline.len();
+    let (a, b) = (outline[cut[0]], outline[cut[1]]);
+    // The cut crosses none of the other sides (those sharing an end with it meet it there).
+    let crosses = (0..n).any(|k| {
+        let (c, d) = (outline[k], outline[(k + 1) % n]);
+        let shared = [a, b].contains(&c) || [a, b].contains(&d);
+        !shared
+            && orient2d(a, b, c) * orient2d(a, b, d) < 0.0
+            && orient2d(c, d, a) * orient2d(c, d, b) < 0.0
+    });
+    if crosses || polygon_area(outline) <= 0.0 {
+        return false;
+    }
+    let (lo, hi) = outline.iter().fold(
         (
             Point::new(f64::INFINITY, f64::INFINITY),
             Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
@@ -568,16 +688,46 @@ fn clear_triangle(g: &CurveGraph, corners: [u32; 3], t: [Point; 3]) -> bool {
             )
         },
     );
-    let sign = orient2d(t[0], t[1], t[2]).signum();
     g.points().iter().enumerate().all(|(u, &q)| {
-        corners.contains(&(u as u32))
+        on.contains(&(u as u32))
             || q.x < lo.x
             || q.x > hi.x
             || q.y < lo.y
             || q.y > hi.y
             || g.valence(u as u32) == 0
-            || (0..3).any(|k| orient2d(t[k], t[(k + 1) % 3], q) * sign < 0.0)
+            || !in_or_on(outline, q)
     })
+}
+
+/// True when `q` lies in the simple polygon `outline` or on its boundary (exact: a winding
+/// number by orientations).
+fn in_or_on(outline: &[Point], q: Point) -> bool {
+    let n = outline.len();
+    let mut winding = 0;
+    for k in 0..n {
+        let (a, b) = (outline[k], outline[(k + 1) % n]);
+        let o = orient2d(a, b, q);
+        let within = q.x >= a.x.min(b.x) && q.x <= a.x.max(b.x);
+        if o == 0.0 && within && q.y >= a.y.min(b.y) && q.y <= a.y.max(b.y) {
+            return true;
+        }
+        if a.y <= q.y {
+            if b.y > q.y && o > 0.0 {
+                winding += 1;
+            }
+        } else if b.y <= q.y && o < 0.0 {
+            winding -= 1;
+        }
+    }
+    winding != 0
+}
+
+/// The signed (shoelace) area of `outline`: positive counter-clockwise.
+fn polygon_area(outline: &[Point]) -> f64 {
+    let n = outline.len();
+    0.5 * (0..n)
+        .map(|k| cross(outline[k], outline[(k + 1) % n]))
+        .sum::<f64>()
 }
 
 /// The length of `d`.
@@ -588,6 +738,11 @@ fn norm(d: Point) -> f64 {
 /// The cross product of `a` and `b`.
 fn cross(a: Point, b: Point) -> f64 {
     a.x * b.y - a.y * b.x
+}
+
+/// The dot product of `a` and `b`.
+fn dot(a: Point, b: Point) -> f64 {
+    a.x * b.x + a.y * b.y
 }
 
 /// The direction of `d` in radians.
@@ -912,6 +1067,78 @@ mod tests {
         CurveGraph::new(points, edges).unwrap()
     }
 
+    /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees) whose sides run
+    /// `first` px, bend by `bend` degrees (the lower side down, the upper up), run `second`
+    /// px more and then turn away from the tip; region 0 around it, in a square frame. `None`
+    /// when that outline crosses itself.
+    fn staircase(
+        angle: f64,
+        first: [f64; 2],
+        bend: [f64; 2],
+        second: [f64; 2],
+        turn: f64,
+    ) -> Option<CurveGraph> {
+        let (sin, cos) = turn.to_radians().sin_cos();
+        let at = |p: Point| Point::new(p.x * cos - p.y * sin, p.x * sin + p.y * cos);
+        let dir = |deg: f64| Point::new(deg.to_radians().cos(), deg.to_radians().sin());
+        let a1 = dir(0.0) * first[0];
+        let a2 = a1 + dir(-bend[0]) * second[0];
+        let b1 = dir(angle) * first[1];
+        let b2 = b1 + dir(angle + bend[1]) * second[1];
+        let a3 = a2 + Point::new(3.0, -3.0);
+        let b3 = b2 + Point::new(-3.0, 3.0);
+        let far = a3.x.max(b2.x).max(a2.x) + 15.0;
+        let top = b3.y.max(b2.y) + 13.0;
+        let s = 3.0 * (far + top);
+        let outline = [
+            Point::new(0.0, 0.0),
+            a1,
+            a2,
+            a3,
+            Point::new(far, a3.y),
+            Point::new(far, top),
+            Point::new(b3.x, top),
+            b3,
+            b2,
+            b1,
+        ];
+        let mut points: Vec<Point> = outline.iter().map(|&p| at(p)).collect();
+        points.extend([(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| at(Point::new(x, y))));
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let mut edges: Vec<GraphEdge> = (0..10).map(|k| e(k, (k + 1) % 10, [1, 0])).collect();
+        edges.extend((10..14).map(|k| e(k, 10 + (k - 9) % 4, [0, OUTSIDE])));
+        let g = CurveGraph::new(points, edges).ok()?;
+        (g.crossing().is_none() && polygon_area(&outline) > 0.0).then_some(g)
+    }
+
+    /// A 20° spike whose sides bend outwards 1.5 px out and run 4 px on, where the region
+    /// turns away: too narrow at the bends for any cut one width wide, it is cut between the
+    /// sides' second vertices (2.6 px apart), the whole staircase given to region 0.
+    #[test]
+    fn a_staircase_tip_is_cut_at_its_second_vertices() {
+        let g = staircase(20.0, [1.5, 1.5], [5.0, 5.0], [4.0, 4.0], 30.0).unwrap();
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.points().len(), g.points().len());
+        for v in [0, 1, 9] {
+            assert_eq!(b.graph.valence(v), 0, "{v}");
+        }
+        let cut = b.graph.edges().last().unwrap();
+        assert_eq!(cut.ends, [2, 8]);
+        for v in cut.ends {
+            for (label, angle) in sectors_at(&b.graph, v) {
+                assert!(angle >= 30.0, "{label} at {v}: {angle}");
+            }
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+    }
+
     /// A 25° spike both of whose sides end 5 px out (2.5 widths), where the region turns away:
     /// too short for a cut across both or from either end, it is cut between their ends, 2.2
     /// px apart, and the triangle given to region 0.
@@ -1008,6 +1235,39 @@ mod tests {
                     for (label, a) in sectors_at(&b.graph, v) {
                         let least = if label == 1 && new { 90.0 } else { 30.0 };
                         prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
+                    }
+                }
+            }
+        }
+
+        /// A tip whose sides bend and run on before the region turns away (a staircase
+        /// spike, cut as far as the second vertex of a side): the same.
+        #[test]
+        fn tips_cut_two_vertices_out_keep_the_graph_sound(
+            angle in 3.0f64..29.0,
+            first in (0.5f64..6.0, 0.5f64..6.0),
+            bend in (-8.0f64..8.0, -8.0f64..8.0),
+            second in (0.5f64..6.0, 0.5f64..6.0),
+            turn in -180.0f64..180.0,
+            width in 0.5f64..4.0,
+        ) {
+            let g = staircase(angle, [first.0, first.1], [bend.0, bend.1], [second.0, second.1], turn);
+            prop_assume!(g.is_some());
+            let g = g.unwrap();
+            let options = TipOptions { width, reach: width, ..TipOptions::default() };
+            if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
+                prop_assert!(b.graph.crossing().is_none());
+                let (before, after) = (areas(&g), areas(&b.graph));
+                prop_assert!(b.area > 0.0);
+                let scale = 1e3;
+                prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
+                prop_assert!((after[&0] - before[&0] - b.area).abs() < 1e-9 * scale);
+                for cut in b.graph.edges().iter().filter(|e| e.labels == [0, 1] || e.labels == [1, 0]) {
+                    for v in cut.ends.into_iter().filter(|&v| v as usize >= g.points().len()) {
+                        for (label, a) in sectors_at(&b.graph, v) {
+                            let least = if label == 1 { 90.0 } else { 30.0 };
+                            prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
+                        }
                     }
                 }
             }
