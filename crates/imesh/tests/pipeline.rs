@@ -121,8 +121,8 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         // repair's bar of 0.5 (coffee's, in a strip a pixel wide, since refinement leaves such
         // strips alone). Gravel's worst, 0.484 once its tips are cut (0.459 at a 27° corner
         // before), is a quad of a strip 1.5 px wide along the border, under its 29.6° corner;
-        // grass's, 0.476 once its tips with a short side are cut from that side's end (0.447
-        // at a 27° corner before), a quad of a gap 1.2 px wide between two regions.
+        // grass's, 0.485 once its tips with a short side are cut from that side's end (0.447
+        // at a 27° corner before), a quad of a gap 1.4 px wide between two regions.
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -151,7 +151,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         if path.ends_with("skimage-grass.png") {
             // Its 26.6° tip, whose shorter side ends 3 px out, is cut from that side's end.
             assert!(r.counts.blunted_tips > 0);
-            assert!(worst > 0.47, "grass: worst scaled Jacobian {worst}");
+            assert!(worst > 0.48, "grass: worst scaled Jacobian {worst}");
         }
         if path.ends_with("skimage-brick.png") {
             // Simplified, boundaries met the border and each other at 8–15°; the boundaries'
