@@ -964,41 +964,50 @@ mod tests {
         assert!(blunt_sharp_tips(&g, &curves, &options).is_none());
     }
 
-    /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
-    /// `long` px along the x axis, its upper side `short` px long, from whose end `a` (vertex 4)
-    /// the region's boundary turns straight up; region 0 around it, in a square frame.
-    fn hook(angle: f64, short: f64, long: f64, turn: f64) -> CurveGraph {
+    /// Region 1 bounded by `outline` (counter-clockwise, its first point at the origin),
+    /// rotated by `turn` degrees about the origin, in region 0 filling a square frame three
+    /// times the outline's extent. `None` when the outline crosses itself.
+    fn in_frame(outline: &[Point], turn: f64) -> Option<CurveGraph> {
         let (sin, cos) = turn.to_radians().sin_cos();
-        let at = |x: f64, y: f64| Point::new(x * cos - y * sin, x * sin + y * cos);
-        let a = angle.to_radians();
-        let (ax, ay, top, s) = (short * a.cos(), short * a.sin(), long, 3.0 * long);
-        let points = vec![
-            at(0.0, 0.0),
-            at(long, 0.0),
-            at(long, top),
-            at(ax, top),
-            at(ax, ay),
-            at(-s, -s),
-            at(s, -s),
-            at(s, s),
-            at(-s, s),
-        ];
+        let at = |p: Point| Point::new(p.x * cos - p.y * sin, p.x * sin + p.y * cos);
+        let s = 3.0
+            * outline
+                .iter()
+                .map(|p| p.x.abs().max(p.y.abs()))
+                .fold(1.0, f64::max);
+        let mut points: Vec<Point> = outline.iter().map(|&p| at(p)).collect();
+        points.extend([(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| at(Point::new(x, y))));
+        let n = outline.len() as u32;
         let e = |a, b, labels| GraphEdge {
             ends: [a, b],
             labels,
         };
-        let edges = vec![
-            e(0, 1, [1, 0]),
-            e(1, 2, [1, 0]),
-            e(2, 3, [1, 0]),
-            e(3, 4, [1, 0]),
-            e(4, 0, [1, 0]),
-            e(5, 6, [0, OUTSIDE]),
-            e(6, 7, [0, OUTSIDE]),
-            e(7, 8, [0, OUTSIDE]),
-            e(8, 5, [0, OUTSIDE]),
+        let mut edges: Vec<GraphEdge> = (0..n).map(|k| e(k, (k + 1) % n, [1, 0])).collect();
+        edges.extend((0..4).map(|k| e(n + k, n + (k + 1) % 4, [0, OUTSIDE])));
+        let g = CurveGraph::new(points, edges).ok()?;
+        (g.crossing().is_none() && polygon_area(outline) > 0.0).then_some(g)
+    }
+
+    /// The direction `deg` degrees from the x axis.
+    fn dir(deg: f64) -> Point {
+        let (sin, cos) = deg.to_radians().sin_cos();
+        Point::new(cos, sin)
+    }
+
+    /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
+    /// `long` px along the x axis, its upper side `short` px long, from whose end `a` (vertex 4)
+    /// the region's boundary turns straight up; region 0 around it, in a square frame. `None`
+    /// when that outline crosses itself (`a` beyond the lower side's end).
+    fn hook(angle: f64, short: f64, long: f64, turn: f64) -> Option<CurveGraph> {
+        let a = dir(angle) * short;
+        let outline = [
+            Point::new(0.0, 0.0),
+            Point::new(long, 0.0),
+            Point::new(long, long),
+            Point::new(a.x, long),
+            a,
         ];
-        CurveGraph::new(points, edges).unwrap()
+        in_frame(&outline, turn)
     }
 
     /// A 20° tip whose upper side ends 3 px out, where the region turns up: too short for a
@@ -1006,7 +1015,7 @@ mod tests {
     /// (2 px) long, the short side and the triangle given to region 0.
     #[test]
     fn a_tip_with_a_short_side_is_cut_from_its_end() {
-        let g = hook(20.0, 3.0, 30.0, 35.0);
+        let g = hook(20.0, 3.0, 30.0, 35.0).unwrap();
         let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
         assert_eq!(b.tips, 1);
         assert!(b.graph.crossing().is_none());
@@ -1039,32 +1048,18 @@ mod tests {
     /// region turning away from the tip at both (outwards at 45°), then closed far off;
     /// region 0 around it, in a square frame.
     fn spike(angle: f64, upper: f64, lower: f64, turn: f64) -> CurveGraph {
-        let (sin, cos) = turn.to_radians().sin_cos();
-        let at = |x: f64, y: f64| Point::new(x * cos - y * sin, x * sin + y * cos);
-        let a = angle.to_radians();
-        let (ax, ay) = (upper * a.cos(), upper * a.sin());
-        let (far, top) = (upper.max(lower) + 15.0, ay + 13.0);
-        let s = 3.0 * far;
-        let points = vec![
-            at(0.0, 0.0),
-            at(lower, 0.0),
-            at(lower + 3.0, -3.0),
-            at(far, -3.0),
-            at(far, top),
-            at(ax - 3.0, ay + 3.0),
-            at(ax, ay),
-            at(-s, -s),
-            at(s, -s),
-            at(s, s),
-            at(-s, s),
+        let a = dir(angle) * upper;
+        let (far, top) = (upper.max(lower) + 15.0, a.y + 13.0);
+        let outline = [
+            Point::new(0.0, 0.0),
+            Point::new(lower, 0.0),
+            Point::new(lower + 3.0, -3.0),
+            Point::new(far, -3.0),
+            Point::new(far, top),
+            Point::new(a.x - 3.0, a.y + 3.0),
+            a,
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
-        let mut edges: Vec<GraphEdge> = (0..7).map(|k| e(k, (k + 1) % 7, [1, 0])).collect();
-        edges.extend((7..11).map(|k| e(k, 7 + (k - 6) % 4, [0, OUTSIDE])));
-        CurveGraph::new(points, edges).unwrap()
+        in_frame(&outline, turn).unwrap()
     }
 
     /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees) whose sides run
@@ -1078,9 +1073,6 @@ mod tests {
         second: [f64; 2],
         turn: f64,
     ) -> Option<CurveGraph> {
-        let (sin, cos) = turn.to_radians().sin_cos();
-        let at = |p: Point| Point::new(p.x * cos - p.y * sin, p.x * sin + p.y * cos);
-        let dir = |deg: f64| Point::new(deg.to_radians().cos(), deg.to_radians().sin());
         let a1 = dir(0.0) * first[0];
         let a2 = a1 + dir(-bend[0]) * second[0];
         let b1 = dir(angle) * first[1];
@@ -1089,7 +1081,6 @@ mod tests {
         let b3 = b2 + Point::new(-3.0, 3.0);
         let far = a3.x.max(b2.x).max(a2.x) + 15.0;
         let top = b3.y.max(b2.y) + 13.0;
-        let s = 3.0 * (far + top);
         let outline = [
             Point::new(0.0, 0.0),
             a1,
@@ -1102,16 +1093,7 @@ mod tests {
             b2,
             b1,
         ];
-        let mut points: Vec<Point> = outline.iter().map(|&p| at(p)).collect();
-        points.extend([(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| at(Point::new(x, y))));
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
-        let mut edges: Vec<GraphEdge> = (0..10).map(|k| e(k, (k + 1) % 10, [1, 0])).collect();
-        edges.extend((10..14).map(|k| e(k, 10 + (k - 9) % 4, [0, OUTSIDE])));
-        let g = CurveGraph::new(points, edges).ok()?;
-        (g.crossing().is_none() && polygon_area(&outline) > 0.0).then_some(g)
+        in_frame(&outline, turn)
     }
 
     /// A 20° spike whose sides bend outwards 1.5 px out and run 4 px on, where the region
@@ -1121,20 +1103,30 @@ mod tests {
     fn a_staircase_tip_is_cut_at_its_second_vertices() {
         let g = staircase(20.0, [1.5, 1.5], [5.0, 5.0], [4.0, 4.0], 30.0).unwrap();
         let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.points().len(), g.points().len());
         for v in [0, 1, 9] {
             assert_eq!(b.graph.valence(v), 0, "{v}");
         }
+        assert_cut_between(&g, &b, [2, 8]);
+    }
+
+    /// The one cut of `b` joins the vertices `ends` of `g` (no new vertex), every corner there
+    /// is 30° or more, and the area it cut off went from region 1 to region 0.
+    fn assert_cut_between(g: &CurveGraph, b: &Blunted, ends: [u32; 2]) {
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.points().len(), g.points().len());
         let cut = b.graph.edges().last().unwrap();
-        assert_eq!(cut.ends, [2, 8]);
+        assert!(
+            cut.ends == ends || cut.ends == [ends[1], ends[0]],
+            "{:?}",
+            cut.ends
+        );
         for v in cut.ends {
             for (label, angle) in sectors_at(&b.graph, v) {
                 assert!(angle >= 30.0, "{label} at {v}: {angle}");
             }
         }
-        let (before, after) = (areas(&g), areas(&b.graph));
+        let (before, after) = (areas(g), areas(&b.graph));
         assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
         assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
     }
@@ -1146,20 +1138,8 @@ mod tests {
     fn a_tip_with_two_short_sides_is_cut_between_their_ends() {
         let g = spike(25.0, 5.0, 5.0, -70.0);
         let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
         assert_eq!(b.graph.valence(0), 0);
-        assert_eq!(b.graph.points().len(), g.points().len());
-        let cut = b.graph.edges().last().unwrap();
-        assert!(cut.ends.contains(&1) && cut.ends.contains(&6));
-        for v in cut.ends {
-            for (label, angle) in sectors_at(&b.graph, v) {
-                assert!(angle >= 30.0, "{label} at {v}: {angle}");
-            }
-        }
-        let (before, after) = (areas(&g), areas(&b.graph));
-        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
-        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+        assert_cut_between(&g, &b, [1, 6]);
         assert!((b.area - 0.5 * 25.0 * 25f64.to_radians().sin()).abs() < 1e-9);
     }
 
@@ -1170,6 +1150,26 @@ mod tests {
         assert!(blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).is_none());
         let g = wedge(20.0, 4.0, 0.0, false);
         assert!(blunt_sharp_tips(&g, &straight(&g), &TipOptions::default()).is_none());
+    }
+
+    /// `b` is `g` (region 1 in region 0) with one tip cut soundly: planar, consistent faces,
+    /// the area (to within `1e-9 · scale`) moved only from region 1 to region 0, and every
+    /// corner at the cut's ends 30° or more, region 1's at a new vertex 90° or more.
+    fn one_sound_cut(g: &CurveGraph, b: &Blunted, scale: f64) -> Result<(), TestCaseError> {
+        prop_assert!(b.graph.crossing().is_none());
+        let (before, after) = (areas(g), areas(&b.graph));
+        prop_assert!(b.area > 0.0);
+        prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
+        prop_assert!((after[&0] - before[&0] - b.area).abs() < 1e-9 * scale);
+        let cut = b.graph.edges().last().unwrap();
+        for v in cut.ends {
+            let new = v as usize >= g.points().len();
+            for (label, a) in sectors_at(&b.graph, v) {
+                let least = if label == 1 && new { 90.0 } else { 30.0 };
+                prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
+            }
+        }
+        Ok(())
     }
 
     proptest! {
@@ -1217,26 +1217,15 @@ mod tests {
             both_short: bool,
         ) {
             let g = if both_short {
-                spike(angle, short, long.min(12.0), turn)
+                Some(spike(angle, short, long.min(12.0), turn))
             } else {
                 hook(angle, short, long.max(10.0), turn)
             };
+            prop_assume!(g.is_some());
+            let g = g.unwrap();
             let options = TipOptions { width, reach: width, ..TipOptions::default() };
             if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
-                prop_assert!(b.graph.crossing().is_none());
-                let (before, after) = (areas(&g), areas(&b.graph));
-                let scale = long * long;
-                prop_assert!(b.area > 0.0);
-                prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
-                prop_assert!((after[&0] - before[&0] - b.area).abs() < 1e-9 * scale);
-                let cut = b.graph.edges().last().unwrap();
-                for v in cut.ends {
-                    let new = v as usize >= g.points().len();
-                    for (label, a) in sectors_at(&b.graph, v) {
-                        let least = if label == 1 && new { 90.0 } else { 30.0 };
-                        prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
-                    }
-                }
+                one_sound_cut(&g, &b, long * long)?;
             }
         }
 
@@ -1256,20 +1245,7 @@ mod tests {
             let g = g.unwrap();
             let options = TipOptions { width, reach: width, ..TipOptions::default() };
             if let Some(b) = blunt_sharp_tips(&g, &straight(&g), &options) {
-                prop_assert!(b.graph.crossing().is_none());
-                let (before, after) = (areas(&g), areas(&b.graph));
-                prop_assert!(b.area > 0.0);
-                let scale = 1e3;
-                prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
-                prop_assert!((after[&0] - before[&0] - b.area).abs() < 1e-9 * scale);
-                for cut in b.graph.edges().iter().filter(|e| e.labels == [0, 1] || e.labels == [1, 0]) {
-                    for v in cut.ends.into_iter().filter(|&v| v as usize >= g.points().len()) {
-                        for (label, a) in sectors_at(&b.graph, v) {
-                            let least = if label == 1 { 90.0 } else { 30.0 };
-                            prop_assert!(a >= least - 1e-6, "{} at {}: {}", label, v, a);
-                        }
-                    }
-                }
+                one_sound_cut(&g, &b, 1e3)?;
             }
         }
     }
