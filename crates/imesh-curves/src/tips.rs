@@ -111,6 +111,15 @@ struct Tip {
     cut: [CutEnd; 2],
 }
 
+/// A tip to cut and its piece: the cut's two ends and the piece's outline (see
+/// [`Tip::piece`]).
+#[derive(Clone, Debug)]
+struct Cut {
+    tip: Tip,
+    ends: [Point; 2],
+    outline: Vec<Point>,
+}
+
 /// Where a tip's cut meets one of its sides.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum CutEnd {
@@ -228,7 +237,11 @@ pub fn blunt_sharp_tips(
         for e in tip.edges() {
             used[e as usize] = true;
         }
-        cuts.push((tip, [outline[i], outline[j]]));
+        cuts.push(Cut {
+            tip,
+            ends: [outline[i], outline[j]],
+            outline,
+        });
     }
     // A cut whose new corners would be sharp themselves (a curve turning back across its
     // chord near the cut) is dropped, and the rest made again.
@@ -274,7 +287,7 @@ pub fn blunt_sharp_tips(
 fn cut_off(
     g: &CurveGraph,
     curves: &[CubicBezier],
-    cuts: &[(Tip, [Point; 2])],
+    cuts: &[Cut],
 ) -> Result<(Blunted, Vec<[u32; 2]>), Vec<usize>> {
     let mut points = g.points().to_vec();
     let mut replaced: Vec<Option<Vec<(GraphEdge, CubicBezier)>>> = vec![None; g.edges().len()];
@@ -283,7 +296,15 @@ fn cut_off(
     let mut added = Vec::new();
     let mut cut_ends = Vec::with_capacity(cuts.len());
     let (mut area, mut moved) = (0.0, 0.0f64);
-    for (i, (tip, cut)) in cuts.iter().enumerate() {
+    for (
+        i,
+        Cut {
+            tip,
+            ends: cut,
+            outline,
+        },
+    ) in cuts.iter().enumerate()
+    {
         for e in tip.edges() {
             cut_of[e as usize] = i;
         }
@@ -311,7 +332,6 @@ fn cut_off(
         cut_ends.push(ids);
         // The piece is counter-clockwise, its cut walked from side 0 to side 1: the piece, now
         // the receiver's, on the cut's left.
-        let (outline, _, _) = tip.piece(g);
         added.push((
             GraphEdge {
                 ends: ids,
@@ -319,10 +339,10 @@ fn cut_off(
             },
             CubicBezier::segment(cut[0], cut[1]),
         ));
-        area += polygon_area(&outline).abs();
+        area += polygon_area(outline).abs();
         // The farthest the boundary moved: its farthest vertex cut off from the cut's line.
         let across = cut[1] - cut[0];
-        for &q in &outline {
+        for &q in outline {
             moved = moved.max(cross(across, q - cut[0]).abs() / norm(across));
         }
     }
