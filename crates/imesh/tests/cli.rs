@@ -837,7 +837,7 @@ fn the_forced_corner_note_names_only_sharp_corners() {
     let out = imesh(&["mesh", mri, "-o", "mri.msh"], dir.path());
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
-        out.status.success() && !said.contains(note) && said.contains("cut off 2 region tips"),
+        out.status.success() && !said.contains(note) && said.contains("cut off 3 region tips"),
         "{said}"
     );
     // A square of one label in another: the image's corners and the square's are right angles,
