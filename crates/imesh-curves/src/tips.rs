@@ -685,13 +685,21 @@ fn moved_end(c: CubicBezier, i: usize, p: Point) -> CubicBezier {
 fn sound_piece(g: &CurveGraph, on: &[u32], outline: &[Point], cut: [usize; 2]) -> bool {
     let n = outline.len();
     let (a, b) = (outline[cut[0]], outline[cut[1]]);
-    // The cut crosses none of the other sides (those sharing an end with it meet it there).
-    let crosses = (0..n).any(|k| {
+    // The cut crosses none of the other sides, and does not run back along a side it shares
+    // an end with (pixel-corner vertices are often collinear).
+    let crosses = (0..n).filter(|&k| k != cut[0]).any(|k| {
         let (c, d) = (outline[k], outline[(k + 1) % n]);
-        let shared = [a, b].contains(&c) || [a, b].contains(&d);
-        !shared
-            && orient2d(a, b, c) * orient2d(a, b, d) < 0.0
-            && orient2d(c, d, a) * orient2d(c, d, b) < 0.0
+        match [a, b].iter().position(|&e| e == c || e == d) {
+            Some(i) => {
+                let (at, to) = ([a, b][i], [b, a][i]);
+                let other = if c == at { d } else { c };
+                orient2d(at, to, other) == 0.0 && dot(to - at, other - at) > 0.0
+            }
+            None => {
+                orient2d(a, b, c) * orient2d(a, b, d) < 0.0
+                    && orient2d(c, d, a) * orient2d(c, d, b) < 0.0
+            }
+        }
     });
     if crosses || polygon_area(outline) <= 0.0 {
         return false;
@@ -1161,6 +1169,35 @@ mod tests {
         assert_eq!(b.graph.valence(0), 0);
         assert_cut_between(&g, &b, [1, 6]);
         assert!((b.area - 0.5 * 25.0 * 25f64.to_radians().sin()).abs() < 1e-9);
+    }
+
+    /// A piece whose cut runs back along the side it starts from (collinear, overlapping it)
+    /// is refused; the same cut meeting a side end to end on one line is not.
+    #[test]
+    fn a_cut_running_back_along_a_side_is_refused() {
+        let points = vec![
+            Point::new(0.0, 0.0),
+            Point::new(4.0, 0.0),
+            Point::new(4.0, 4.0),
+        ];
+        let e = |a, b| GraphEdge {
+            ends: [a, b],
+            labels: [1, 0],
+        };
+        let g = CurveGraph::new(points.clone(), vec![e(0, 1), e(1, 2)]).unwrap();
+        let piece = |last: Point| [points[0], points[1], points[2], last];
+        assert!(!sound_piece(
+            &g,
+            &[0, 1, 2],
+            &piece(Point::new(4.0, 2.0)),
+            [2, 3]
+        ));
+        assert!(sound_piece(
+            &g,
+            &[0, 1, 2],
+            &piece(Point::new(2.0, 2.0)),
+            [2, 3]
+        ));
     }
 
     /// Nothing to cut: a sector of 40°, and a 20° tip whose sides are too short.

@@ -148,6 +148,15 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
                 r.quality.scaled_jacobian().min
             );
         }
+        if path.ends_with("opencv-aloeGT.png") {
+            // Its pixel spikes and staircases: 234 tips cut (180 before they could be cut from
+            // a short side's end; none at all if one bad cut dropped every cut).
+            assert!(
+                r.counts.blunted_tips > 200,
+                "aloe: {} tips",
+                r.counts.blunted_tips
+            );
+        }
         if path.ends_with("skimage-grass.png") {
             // Its 26.6° tip, whose shorter side ends 3 px out, is cut from that side's end.
             assert!(r.counts.blunted_tips > 0);
