@@ -607,7 +607,8 @@ pub(crate) fn vertex_cells(g: &CurveGraph, grid: &Grid) -> CellLists<(u32, Point
     CellLists::new(grid.len(), &pairs)
 }
 
-fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
+/// The lower-left and upper-right corners of the box around `points`.
+pub(crate) fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
     points.fold(
         (
             Point::new(f64::INFINITY, f64::INFINITY),
@@ -626,14 +627,20 @@ fn bounding_box(points: impl Iterator<Item = Point>) -> (Point, Point) {
 /// curve winds around it. Exact: winding number by upward/downward crossings decided with
 /// `orient2d`.
 pub(crate) fn encloses(points: &[Point], chain: &[u32], p: Point) -> bool {
-    let mut winding = 0i64;
     let closing = [chain[chain.len() - 1], chain[0]];
-    let edges = chain
+    let sides = chain
         .windows(2)
         .map(|w| [w[0], w[1]])
-        .chain(std::iter::once(closing));
-    for [u, w] in edges {
-        let (a, b) = (points[u as usize], points[w as usize]);
+        .chain(std::iter::once(closing))
+        .map(|[u, w]| (points[u as usize], points[w as usize]));
+    winds_around(sides, p)
+}
+
+/// True when `p` lies on the closed curve made of `sides` (each from its first point to its
+/// second, end to end) or the curve winds around it; exact, as [`encloses`].
+pub(crate) fn winds_around(sides: impl IntoIterator<Item = (Point, Point)>, p: Point) -> bool {
+    let mut winding = 0i64;
+    for (a, b) in sides {
         let in_y = (a.y <= p.y) != (b.y <= p.y);
         let in_box = within(a, b, p);
         if !in_y && !in_box {

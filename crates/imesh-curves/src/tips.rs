@@ -19,6 +19,7 @@ use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 
 use crate::corners::chord;
+use crate::simplify::{bounding_box, winds_around};
 use crate::{CubicBezier, CurveGraph, GraphEdge};
 
 /// The label of the outside of the domain: a tip is never given to it.
@@ -132,6 +133,11 @@ enum CutEnd {
 }
 
 impl Tip {
+    /// `labels` with the receiver for the region: an edge's piece the region gives away.
+    fn relabel(&self, labels: [u32; 2]) -> [u32; 2] {
+        labels.map(|l| if l == self.region { self.receiver } else { l })
+    }
+
     /// The edges the cut takes in part or whole.
     fn edges(&self) -> impl Iterator<Item = u32> + '_ {
         (0..2).flat_map(move |k| {
@@ -595,9 +601,7 @@ fn relabelled(
     tip: &Tip,
 ) -> Vec<(GraphEdge, CubicBezier)> {
     let e = g.edges()[edge as usize];
-    let labels = e
-        .labels
-        .map(|l| if l == tip.region { tip.receiver } else { l });
+    let labels = tip.relabel(e.labels);
     if labels[0] == labels[1] {
         Vec::new()
     } else {
@@ -624,8 +628,7 @@ fn split(
     let t = curve.closest_parameter(p, if end.at_start { share } else { 1.0 - share });
     let (first, second) = curve.split(t);
     let (first, second) = (moved_end(first, 3, p), moved_end(second, 0, p));
-    let relabel = |l: u32| if l == tip.region { tip.receiver } else { l };
-    let near_labels = e.labels.map(relabel);
+    let near_labels = tip.relabel(e.labels);
     let mut pieces = Vec::with_capacity(2);
     let (near, far) = if end.at_start {
         (
@@ -704,18 +707,7 @@ fn sound_piece(g: &CurveGraph, on: &[u32], outline: &[Point], cut: [usize; 2]) -
     if crosses || polygon_area(outline) <= 0.0 {
         return false;
     }
-    let (lo, hi) = outline.iter().fold(
-        (
-            Point::new(f64::INFINITY, f64::INFINITY),
-            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| {
-            (
-                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
-                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
-            )
-        },
-    );
+    let (lo, hi) = bounding_box(outline.iter().copied());
     g.points().iter().enumerate().all(|(u, &q)| {
         on.contains(&(u as u32))
             || q.x < lo.x
@@ -723,31 +715,8 @@ fn sound_piece(g: &CurveGraph, on: &[u32], outline: &[Point], cut: [usize; 2]) -
             || q.y < lo.y
             || q.y > hi.y
             || g.valence(u as u32) == 0
-            || !in_or_on(outline, q)
+            || !winds_around((0..n).map(|k| (outline[k], outline[(k + 1) % n])), q)
     })
-}
-
-/// True when `q` lies in the simple polygon `outline` or on its boundary (exact: a winding
-/// number by orientations).
-fn in_or_on(outline: &[Point], q: Point) -> bool {
-    let n = outline.len();
-    let mut winding = 0;
-    for k in 0..n {
-        let (a, b) = (outline[k], outline[(k + 1) % n]);
-        let o = orient2d(a, b, q);
-        let within = q.x >= a.x.min(b.x) && q.x <= a.x.max(b.x);
-        if o == 0.0 && within && q.y >= a.y.min(b.y) && q.y <= a.y.max(b.y) {
-            return true;
-        }
-        if a.y <= q.y {
-            if b.y > q.y && o > 0.0 {
-                winding += 1;
-            }
-        } else if b.y <= q.y && o < 0.0 {
-            winding -= 1;
-        }
-    }
-    winding != 0
 }
 
 /// The signed (shoelace) area of `outline`: positive counter-clockwise.
