@@ -177,7 +177,7 @@ fn improve(vars: &Variables, i: usize, vertices: &mut [Point], setup: &Setup, ba
 /// Jacobian of `quads` (all the quads they are corners of), then, at an equal one, their
 /// smallest shape, both capped at `bar`; every quad held to the floors of `setup`. True when a
 /// vertex moved.
-fn compass(
+pub(crate) fn compass(
     moving: &[usize],
     groups: &[u32],
     quads: &[u32],

@@ -159,6 +159,30 @@ impl Sliders {
         near
     }
 
+    /// Per quad vertex of a mesh of `n` vertices: the slider that moves it, or `u32::MAX`.
+    pub fn slider_of_vertices(&self, n: usize) -> Vec<u32> {
+        let mut of = vec![u32::MAX; n];
+        for (i, &(c, j)) in self.slot.iter().enumerate() {
+            of[self.chains[c as usize].vertices[j as usize] as usize] = i as u32;
+        }
+        of
+    }
+
+    /// Slider `i`'s position along its chain, and its neighbours' on either side.
+    pub fn gap(&self, i: usize) -> [f64; 3] {
+        let (c, j) = self.slot[i];
+        let along = &self.along[c as usize];
+        let j = j as usize;
+        [along[j - 1], along[j], along[j + 1]]
+    }
+
+    /// Puts slider `i` at `along` (not checked against its neighbours) and returns its point.
+    pub fn place(&mut self, i: usize, along: f64) -> Point {
+        let (c, j) = self.slot[i];
+        self.along[c as usize][j as usize] = along;
+        self.chains[c as usize].point(along)
+    }
+
     /// Sweeps over the sliders, colour by colour, until a sweep lowers the energy of the quads
     /// they move by less than `setup.tolerance` of it, or `sweeps` of them. Returns the sweeps.
     pub fn sweep(&mut self, vertices: &mut [Point], setup: &Setup<'_>, sweeps: usize) -> usize {

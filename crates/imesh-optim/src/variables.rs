@@ -163,6 +163,20 @@ fn constrained_edges(t: &Triangulation, m: &ElementMesh) -> Vec<bool> {
     m.edges.iter().map(|&h| t.is_constrained(h)).collect()
 }
 
+/// Per quad vertex, whether it is fixed in the vertex mode: on a constrained M edge (a c-edge
+/// or the domain border).
+pub(crate) fn fixed_vertices(t: &Triangulation, m: &ElementMesh, mesh: &QuadMesh) -> Vec<bool> {
+    let mut fixed = vec![false; mesh.vertices.len()];
+    for (e, &c) in constrained_edges(t, m).iter().enumerate() {
+        if c {
+            for v in mesh.edge_vertices(t, m, e as u32) {
+                fixed[v as usize] = true;
+            }
+        }
+    }
+    fixed
+}
+
 /// Per quad vertex, the quads around it.
 pub(crate) fn vertex_quads(mesh: &QuadMesh) -> Rows<u32> {
     let pairs: Vec<(u32, u32)> = (mesh.quads.iter().enumerate())
@@ -293,14 +307,7 @@ impl Variables {
         mesh: &QuadMesh,
         wanted: impl Fn(u32) -> bool,
     ) -> Self {
-        let mut fixed = vec![false; mesh.vertices.len()];
-        for (e, &c) in constrained_edges(t, m).iter().enumerate() {
-            if c {
-                for v in mesh.edge_vertices(t, m, e as u32) {
-                    fixed[v as usize] = true;
-                }
-            }
-        }
+        let fixed = fixed_vertices(t, m, mesh);
         let ids: Vec<u32> = (0..mesh.vertices.len() as u32)
             .filter(|&v| !fixed[v as usize] && wanted(v))
             .collect();

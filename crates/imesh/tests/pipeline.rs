@@ -119,9 +119,9 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         // scaled Jacobian; on all fixtures but two the worst is either such a corner, where the
         // curves could not be turned wider within the tolerance nor the tip cut, or at the
         // repair's bar of 0.5 (coffee's, in a strip a pixel wide, since refinement leaves such
-        // strips alone). Gravel's worst, 0.484 once its tips are cut (0.459 at a 27° corner
-        // before), is a quad of a strip 1.5 px wide along the border, under its 29.6° corner;
-        // grass's, 0.485 once its tips with a short side are cut from that side's end (0.447
+        // strips alone). Gravel's, 0.484 once its tips were cut (0.459 at a 27° corner
+        // before), a quad of a strip 1.5 px wide along the border, under its 29.6° corner, is
+        // at 0.5 since its neighbourhood moves as a whole (below); grass's, 0.485 once its tips with a short side are cut from that side's end (0.447
         // at a 27° corner before), a quad of a gap 1.4 px wide between two regions.
         let corner = r
             .sharpest_boundary_corner
@@ -135,6 +135,17 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         if worst >= corner.scaled_jacobian - 1e-9 || worst >= 0.5 {
             at_a_bound += 1;
         }
+        // The worst shape: once the repairs stall, each poor quad's neighbourhood moves as a
+        // whole (camera's kite of four quads in a 37° wedge 0.251 → 0.450, coffee 0.306 →
+        // 0.442, brick 0.383 → 0.459, gravel 0.321 → 0.414). Grass and aloe keep poorer quads
+        // in their pixel-wide gaps and spikes (0.345 and 0.283).
+        let shape = r.quality.shape().min;
+        let rough = path.ends_with("skimage-grass.png") || path.ends_with("opencv-aloeGT.png");
+        assert!(
+            shape > if rough { 0.25 } else { 0.4 },
+            "{}: worst shape {shape}",
+            path.display()
+        );
         if path.ends_with("pyvista-channels_z050_labels.png")
             || path.ends_with("skimage-gravel.png")
         {
@@ -187,7 +198,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_a_bound >= 8, "{at_a_bound}");
+    assert!(at_a_bound >= 9, "{at_a_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
