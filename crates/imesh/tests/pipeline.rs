@@ -136,16 +136,18 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
             at_a_bound += 1;
         }
         // The worst shape: once the repairs stall, each poor quad's neighbourhood moves as a
-        // whole (camera's kite of four quads in a 37° wedge 0.251 → 0.450, coffee 0.306 →
-        // 0.442, brick 0.383 → 0.459, gravel 0.321 → 0.414). Grass and aloe keep poorer quads
-        // in their pixel-wide gaps and spikes (0.345 and 0.283).
+        // whole (camera's kite of four quads in a 37° wedge 0.251 → 0.480, coffee 0.306 →
+        // 0.431, brick 0.383 → 0.462, gravel 0.321 → 0.414, grass 0.302 → 0.388). Aloe keeps
+        // poorer quads in its tangles of pixel-wide regions (0.294).
         let shape = r.quality.shape().min;
-        let rough = path.ends_with("skimage-grass.png") || path.ends_with("opencv-aloeGT.png");
-        assert!(
-            shape > if rough { 0.25 } else { 0.4 },
-            "{}: worst shape {shape}",
-            path.display()
-        );
+        let bound = if path.ends_with("opencv-aloeGT.png") {
+            0.25
+        } else if path.ends_with("skimage-grass.png") {
+            0.35
+        } else {
+            0.4
+        };
+        assert!(shape > bound, "{}: worst shape {shape}", path.display());
         if path.ends_with("pyvista-channels_z050_labels.png")
             || path.ends_with("skimage-gravel.png")
         {
