@@ -271,7 +271,7 @@ fn shortfall(quads: &[u32], points: &[Point], setup: &Setup, bar: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::repair_jointly;
-    use crate::repair::{compass, REPAIR_FLOOR, REPAIR_JACOBIAN};
+    use crate::repair::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::slide::Sliders;
     use crate::variables::Rows;
     use crate::{LocalSolver, Metric, Setup};
@@ -354,19 +354,7 @@ mod tests {
     /// every quad valid and held to its floors, the pinned vertices where they were.
     #[test]
     fn moving_the_whole_patch_passes_where_one_vertex_at_a_time_stalls() {
-        let mut points: Vec<Point> = [
-            (0.31, 0.1),
-            (0.69, -0.22),
-            (1.87, -0.15),
-            (0.11, 1.32),
-            (1.16, 1.21),
-            (1.7, 1.18),
-            (0.31, 2.34),
-            (1.33, 1.68),
-            (1.74, 2.35),
-        ]
-        .map(|(x, y)| Point::new(x, y))
-        .to_vec();
+        let mut points = stalling_grid();
         let quads = grid_quads(3);
         let floors = floors(&quads, &points);
         let none = [0.0; 4];
@@ -430,16 +418,15 @@ mod tests {
                 .collect();
             let before = points.clone();
             let all: Vec<u32> = (0..quads.len() as u32).collect();
+            let around = around(&quads, (n * n) as usize);
+            let repaired = |slack: f64| {
+                let mut points = before.clone();
+                let mut sliders = Sliders::default();
+                repair_jointly(&mut points, &around, &fixed, &mut sliders, &setup, REPAIR_JACOBIAN, slack);
+                points
+            };
             let start = worst(&quads, &points, scaled_jacobian).min(REPAIR_JACOBIAN);
-            repair_jointly(
-                &mut points,
-                &around(&quads, (n * n) as usize),
-                &fixed,
-                &mut Sliders::default(),
-                &setup,
-                REPAIR_JACOBIAN,
-                f64::INFINITY,
-            );
+            points = repaired(f64::INFINITY);
             let end = worst(&quads, &points, scaled_jacobian).min(REPAIR_JACOBIAN);
             prop_assert!(end >= start, "{start} → {end}");
             for (q, quad) in quads.iter().enumerate() {
@@ -449,16 +436,7 @@ mod tests {
                 prop_assert!(!fixed[v] || points[v] == before[v]);
             }
             // With no energy to give back, no patch may raise the energy.
-            let mut held = before.clone();
-            repair_jointly(
-                &mut held,
-                &around(&quads, (n * n) as usize),
-                &fixed,
-                &mut Sliders::default(),
-                &setup,
-                REPAIR_JACOBIAN,
-                0.0,
-            );
+            let held = repaired(0.0);
             let energy = |points: &[Point]| super::energy(&all, points, &setup);
             prop_assert!(energy(&held) <= energy(&before) + 1e-12);
         }

@@ -267,9 +267,29 @@ pub(crate) fn corners_value(
     Some((jacobian, shape))
 }
 
+/// The 3 × 3 grid of points (row by row) of the repairs' tests: with every point pinned but the
+/// middle one and its right neighbour, and each of the four quads held to the repair's floors,
+/// moving one free vertex at a time stalls under [`REPAIR_JACOBIAN`].
+#[cfg(test)]
+pub(crate) fn stalling_grid() -> Vec<Point> {
+    [
+        (0.31, 0.1),
+        (0.69, -0.22),
+        (1.87, -0.15),
+        (0.11, 1.32),
+        (1.16, 1.21),
+        (1.7, 1.18),
+        (0.31, 2.34),
+        (1.33, 1.68),
+        (1.74, 2.35),
+    ]
+    .map(|(x, y)| Point::new(x, y))
+    .to_vec()
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{compass, REPAIR_FLOOR, REPAIR_JACOBIAN};
+    use super::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::{LocalSolver, Metric, Setup};
     use imesh_geom::Point;
 
@@ -291,19 +311,7 @@ mod tests {
     /// floor), and moving the two together gets past it.
     #[test]
     fn moving_corners_together_passes_where_one_at_a_time_stalls() {
-        let mut vertices: Vec<Point> = [
-            (0.31, 0.1),
-            (0.69, -0.22),
-            (1.87, -0.15),
-            (0.11, 1.32),
-            (1.16, 1.21),
-            (1.7, 1.18),
-            (0.31, 2.34),
-            (1.33, 1.68),
-            (1.74, 2.35),
-        ]
-        .map(|(x, y)| Point::new(x, y))
-        .to_vec();
+        let mut vertices = stalling_grid();
         let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
         let floors = |metric: fn(&[[f64; 2]; 4]) -> f64| -> Vec<f64> {
             quads
