@@ -170,8 +170,9 @@ pub struct OptimOptions {
     /// shape (up to that bar), every quad held to [`REPAIR_FLOOR`] or its own values if lower;
     /// then the free corners of each quad still under the bar move two or more at a time;
     /// then, for each quad still under it, every free vertex and boundary vertex of the quads
-    /// around its corners in one [`Powell`] run (`joint.rs`); undone if it would leave the energy above the start's. The energy leaves such quads
-    /// where their shape-and-size is fair. Measured with the defaults (a bar of 0.4 and the
+    /// around its corners in one [`Powell`] run (`joint.rs`); undone if it would leave the
+    /// energy above the start's. The energy leaves such quads where their shape-and-size is
+    /// fair. Measured with the defaults (a bar of 0.4 and the
     /// descent's floors then): worst scaled Jacobian stardist 0.272 → 0.355, coffee
     /// 0.251 → 0.280, grass 0.280 → 0.299, MRI 0.352 → 0.371, camera 0.358 → 0.383; worst shape
     /// stardist 0.232 → 0.312, coffee 0.192 → 0.224, grass 0.068 → 0.119, gravel 0.075 →
