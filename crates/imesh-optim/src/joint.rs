@@ -68,19 +68,15 @@ pub(crate) fn repair_jointly(
     bar: f64,
     mut slack: f64,
 ) -> usize {
-    let shape_of = |q: u32, points: &[Point]| {
-        let p = setup.quads[q as usize].map(|v| [points[v as usize].x, points[v as usize].y]);
-        imesh_quality::quad::shape(&p)
-    };
     let mut poor: Vec<(f64, u32)> = (0..setup.quads.len() as u32)
-        .map(|q| (shape_of(q, points), q))
+        .map(|q| (setup.shape(points, q as usize), q))
         .filter(|&(s, _)| s < bar)
         .collect();
     poor.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let slider_of = sliders.slider_of_vertices(points.len());
     let mut moved = 0;
     for (_, q) in poor {
-        if shape_of(q, points) >= bar {
+        if setup.shape(points, q as usize) >= bar {
             continue;
         }
         // The patch: the corners of the quads around the poor quad's corners.
@@ -239,12 +235,7 @@ fn place(movers: &[Mover], x: &[f64], points: &mut [Point], sliders: &mut Slider
 fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
     quads
         .iter()
-        .map(|&q| {
-            let s = setup
-                .quality(&setup.quads[q as usize].map(|u| points[u as usize]))
-                .0;
-            (1.0 - s) * (1.0 - s)
-        })
+        .map(|&q| (1.0 - setup.value(points, q as usize)).powi(2))
         .sum()
 }
 

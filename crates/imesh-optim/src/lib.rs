@@ -295,6 +295,12 @@ impl Setup<'_> {
         self.quality(&p).0
     }
 
+    /// Verdict's shape of quad `q` over `vertices` (the repairs' measure of a poor quad).
+    pub fn shape(&self, vertices: &[Point], q: usize) -> f64 {
+        let p = self.quads[q].map(|v| [vertices[v as usize].x, vertices[v as usize].y]);
+        imesh_quality::quad::shape(&p)
+    }
+
     /// The metric `s` and the shape of quad `p`, in one pass: Verdict's shape, and the relative
     /// size from the shoelace area (Verdict's `¼ Σ α_k`, the same area up to rounding), so that
     /// every energy term, floor and gradient here agrees to the bit.

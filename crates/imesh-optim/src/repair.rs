@@ -68,11 +68,7 @@ pub(crate) fn repair(
     // The quads under the bar: by shape, which is at most the scaled Jacobian at every corner.
     let poor = |vertices: &[Point]| -> Vec<u32> {
         (0..setup.quads.len() as u32)
-            .filter(|&q| {
-                let p = setup.quads[q as usize]
-                    .map(|v| [vertices[v as usize].x, vertices[v as usize].y]);
-                imesh_quality::quad::shape(&p) < bar
-            })
+            .filter(|&q| setup.shape(vertices, q as usize) < bar)
             .collect()
     };
     let first = poor(&mesh.vertices);

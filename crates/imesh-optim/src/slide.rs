@@ -222,11 +222,9 @@ impl Sliders {
         let mut moved = 0;
         for i in 0..self.slot.len() {
             let quads = self.quads.row(i);
-            let poor = quads.iter().any(|&q| {
-                let p = setup.quads[q as usize]
-                    .map(|u| [vertices[u as usize].x, vertices[u as usize].y]);
-                imesh_quality::quad::shape(&p) < bar
-            });
+            let poor = quads
+                .iter()
+                .any(|&q| setup.shape(vertices, q as usize) < bar);
             if !poor {
                 continue;
             }
