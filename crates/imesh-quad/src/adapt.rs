@@ -122,14 +122,13 @@ pub fn adapt_within(
 ) -> (AdaptReport, Vec<EdgeCurve>) {
     let t = &dt.triangulation;
     let mut report = AdaptReport::default();
-    let mut adapted = Vec::new();
     let mut curve_of_edge = vec![NONE; m.edges.len()];
     let mut pieces: Vec<Vec<u32>> = vec![Vec::new(); g.edges().len()];
     let parameter = curve_parameters(dt, g, curves);
     // The G' edge a Steiner vertex lies on: its move onto the curve affects every element
     // around it, not only those with a side on the curve.
     let mut curve_of_vertex = vec![NONE; t.num_vertices()];
-    let found: Vec<EdgeCurve> = m
+    let mut adapted: Vec<EdgeCurve> = m
         .edges
         .par_iter()
         .enumerate()
@@ -164,17 +163,16 @@ pub fn adapt_within(
             })
         })
         .collect();
-    for ec in found {
+    for (p, ec) in adapted.iter().enumerate() {
         let (e, k) = (ec.edge as usize, ec.graph_edge);
-        curve_of_edge[e] = adapted.len() as u32;
-        pieces[k as usize].push(adapted.len() as u32);
+        curve_of_edge[e] = p as u32;
+        pieces[k as usize].push(p as u32);
         let h = m.edges[e];
         for v in [t.origin(h), t.destination(h)] {
             if dt.graph_vertex[v.index()] == NONE {
                 curve_of_vertex[v.index()] = k;
             }
         }
-        adapted.push(ec);
     }
     for ec in &adapted {
         place(dt, m, net, ec);

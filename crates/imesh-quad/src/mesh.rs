@@ -560,7 +560,7 @@ fn disjoint_slices<T>(
     mut data: &mut [T],
     ranges: impl Iterator<Item = (usize, usize)>,
 ) -> Vec<&mut [T]> {
-    let mut out = Vec::new();
+    let mut out = Vec::with_capacity(ranges.size_hint().0);
     let mut offset = 0;
     for (start, len) in ranges {
         let (_, rest) = std::mem::take(&mut data).split_at_mut(start - offset);

@@ -157,15 +157,15 @@ impl ElementMesh {
             }
             labels.push(t.label(f));
         }
+        let edges: Vec<HalfEdgeId> = (0..t.num_half_edge_slots() as u32)
+            .into_par_iter()
+            .map(HalfEdgeId::new)
+            .filter(|&h| !diagonal[h.index()] && t.is_edge_representative(h))
+            .collect();
         let mut edge_of_half = vec![NONE; 3 * slots];
-        let mut edges = Vec::with_capacity(2 * slots);
-        for h in t.edges() {
-            if diagonal[h.index()] {
-                continue;
-            }
-            edge_of_half[h.index()] = edges.len() as u32;
-            edge_of_half[t.twin(h).index()] = edges.len() as u32;
-            edges.push(h);
+        for (e, &h) in edges.iter().enumerate() {
+            edge_of_half[h.index()] = e as u32;
+            edge_of_half[t.twin(h).index()] = e as u32;
         }
         Self {
             elements,
@@ -218,10 +218,13 @@ fn best_first(
     t: &Triangulation,
     key: impl Fn(HalfEdgeId) -> Option<f64> + Sync,
 ) -> Vec<HalfEdgeId> {
-    let edges: Vec<HalfEdgeId> = t.edges().collect();
-    let mut order: Vec<u128> = edges
+    let mut order: Vec<u128> = (0..t.num_half_edge_slots() as u32)
         .into_par_iter()
+        .map(HalfEdgeId::new)
         .filter_map(|h| {
+            if !t.is_edge_representative(h) {
+                return None;
+            }
             let key = key(h)?;
             debug_assert!(key >= 0.0);
             Some((u128::from(!key.to_bits()) << 32) | h.index() as u128)
