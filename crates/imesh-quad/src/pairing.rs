@@ -157,11 +157,7 @@ impl ElementMesh {
             }
             labels.push(t.label(f));
         }
-        let edges: Vec<HalfEdgeId> = (0..t.num_half_edge_slots() as u32)
-            .into_par_iter()
-            .map(HalfEdgeId::new)
-            .filter(|&h| !diagonal[h.index()] && t.is_edge_representative(h))
-            .collect();
+        let edges: Vec<HalfEdgeId> = par_edges(t).filter(|&h| !diagonal[h.index()]).collect();
         let mut edge_of_half = vec![NONE; 3 * slots];
         for (e, &h) in edges.iter().enumerate() {
             edge_of_half[h.index()] = e as u32;
@@ -177,6 +173,14 @@ impl ElementMesh {
             element_of_triangle,
         }
     }
+}
+
+/// [`Triangulation::edges`] in parallel, in the same order when collected.
+fn par_edges(t: &Triangulation) -> impl ParallelIterator<Item = HalfEdgeId> + '_ {
+    (0..3 * t.num_triangle_slots() as u32)
+        .into_par_iter()
+        .map(HalfEdgeId::new)
+        .filter(|&h| t.is_edge_representative(h))
 }
 
 /// The quad `a, d, b, c` made by the triangle of `h` (a → b → c) and its neighbour across `h`
@@ -218,13 +222,8 @@ fn best_first(
     t: &Triangulation,
     key: impl Fn(HalfEdgeId) -> Option<f64> + Sync,
 ) -> Vec<HalfEdgeId> {
-    let mut order: Vec<u128> = (0..t.num_half_edge_slots() as u32)
-        .into_par_iter()
-        .map(HalfEdgeId::new)
+    let mut order: Vec<u128> = par_edges(t)
         .filter_map(|h| {
-            if !t.is_edge_representative(h) {
-                return None;
-            }
             let key = key(h)?;
             debug_assert!(key >= 0.0);
             Some((u128::from(!key.to_bits()) << 32) | h.index() as u128)

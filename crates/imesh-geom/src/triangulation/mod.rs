@@ -301,25 +301,20 @@ impl Triangulation {
     /// One half-edge of every undirected edge between two real vertices: those for which
     /// [`Triangulation::is_edge_representative`] holds, in increasing order.
     pub fn edges(&self) -> impl Iterator<Item = HalfEdgeId> + '_ {
-        (0..self.num_half_edge_slots() as u32)
+        (0..self.origin.len() as u32)
             .map(HalfEdgeId)
             .filter(|&e| self.is_edge_representative(e))
     }
 
-    /// Half-edge slots, live or not: every half-edge id is below this.
-    pub fn num_half_edge_slots(&self) -> usize {
-        self.origin.len()
-    }
-
     /// True when `e` is the half-edge [`Triangulation::edges`] lists for its edge: it lies in a
-    /// real triangle, and its twin does not or has a larger id. A filter over the slots
-    /// `0..num_half_edge_slots()` that a caller can run in parallel.
+    /// real triangle, and its twin does not or has a larger id. A filter over the half-edge
+    /// slots `0..3 * num_triangle_slots()` that a caller can run in parallel.
     ///
     /// ```
     /// use imesh_geom::{HalfEdgeId, Point, Triangulation};
     /// let pts = [Point::new(0.0, 0.0), Point::new(2.0, 0.0), Point::new(0.0, 2.0), Point::new(2.0, 2.0)];
     /// let (t, _) = Triangulation::from_points(&pts).unwrap();
-    /// let listed = (0..t.num_half_edge_slots() as u32)
+    /// let listed = (0..3 * t.num_triangle_slots() as u32)
     ///     .filter(|&e| t.is_edge_representative(HalfEdgeId::new(e)))
     ///     .count();
     /// assert_eq!(listed, 5); // the square's four sides and its diagonal
