@@ -689,6 +689,34 @@ mod tests {
         Ok(())
     }
 
+    /// Two or four coincident corners make a corner's shape 0/0: the quad's shape is still 0,
+    /// wherever the NaN corner falls in the order of the corners.
+    #[test]
+    fn a_quad_with_coincident_corners_has_shape_zero() {
+        let (a, b, c) = (
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(0.0, 1.0),
+        );
+        for quad in [
+            [a, a, a, b],
+            [a, b, a, a],
+            [a, a, b, c],
+            [b, a, a, a],
+            [a, a, a, a],
+        ] {
+            for turn in 0..4 {
+                let p: [Point; 4] = std::array::from_fn(|i| quad[(i + turn) % 4]);
+                assert_eq!(energy::shape(&p), 0.0, "{p:?}");
+                assert_eq!(
+                    imesh_quality::quad::shape(&p.map(|p| [p.x, p.y])),
+                    0.0,
+                    "{p:?}"
+                );
+            }
+        }
+    }
+
     proptest! {
         /// The shortcut of [`SURE_SHAPE`] never calls a quad valid that the exact test calls
         /// invalid: random quads, flat ones (a corner nudged by a hair off its neighbours'

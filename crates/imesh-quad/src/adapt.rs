@@ -6,7 +6,7 @@ use imesh_geom::{Point, VertexId};
 use rayon::prelude::*;
 
 use crate::dt::{RegionTriangulation, NONE};
-use crate::mesh::QuadMesh;
+use crate::mesh::{disjoint_slices, QuadMesh};
 use crate::pairing::ElementMesh;
 use crate::patch::{relaxed_inner, side_slots, ControlNet};
 
@@ -193,16 +193,22 @@ pub fn adapt_within(
         })
         .collect();
     let mut bar = vec![f64::NEG_INFINITY; q.quads.len()];
-    let bars: Vec<(usize, f64)> = touched
-        .par_iter()
-        .flat_map_iter(|&index| {
-            let q = &*q;
-            q.element_quads(index)
-                .map(move |x| (x, POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9))
-        })
-        .collect();
-    for (x, b) in bars {
-        bar[x] = b;
+    {
+        // An element's quads are consecutive, and the touched elements increasing: each
+        // element's bars are a slice of their own.
+        let q = &*q;
+        let slices = disjoint_slices(
+            &mut bar,
+            touched.iter().map(|&index| {
+                let quads = q.element_quads(index);
+                (quads.start, quads.len())
+            }),
+        );
+        touched.par_iter().zip(slices).for_each(|(&index, out)| {
+            for (x, b) in q.element_quads(index).zip(out) {
+                *b = POOR_SCALED_JACOBIAN.min(q.scaled_jacobian(x)) - 1e-9;
+            }
+        });
     }
     // Per round, which M edges it has evaluated.
     let mut edge_stamp = vec![0u32; m.edges.len()];

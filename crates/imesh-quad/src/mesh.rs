@@ -556,7 +556,7 @@ fn inside_points(
 
 /// The slices `[start, start + len)` of `data`, for ranges in increasing order that do not
 /// overlap: each can be written by its own worker.
-fn disjoint_slices<T>(
+pub(crate) fn disjoint_slices<T>(
     mut data: &mut [T],
     ranges: impl Iterator<Item = (usize, usize)>,
 ) -> Vec<&mut [T]> {
