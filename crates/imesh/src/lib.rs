@@ -461,10 +461,13 @@ pub struct Counts {
     pub grid_width: u32,
     /// Height of the meshed grid in cells.
     pub grid_height: u32,
-    /// Labels in the label grid.
+    /// Labels in the label grid meshed (after the clean-up).
     pub labels: usize,
+    /// Labels with a pixel in the image's own label grid, before any reduction or clean-up.
+    pub image_labels: usize,
     /// Labels the mesh's elements carry (one physical group each in the written files): fewer
-    /// than `labels` when the clean-up merged every region of a label away.
+    /// than `image_labels` when the reduction or the clean-up merged every region of a label
+    /// away.
     pub meshed_labels: usize,
     /// Pixels whose label the clean-up (`majority`, `min_region`) changed; label agreement is
     /// measured against the image's own labels, so they count against it.
@@ -999,6 +1002,7 @@ impl Pipeline {
         (mesh.width, mesh.height) = (original.width(), original.height());
         (counts.width, counts.height) = (mesh.width, mesh.height);
         counts.reduction = factor;
+        counts.image_labels = labels_present(original);
         let (sx, sy) = (w / cw, h / ch);
         counts.quad_size *= sx;
         counts.dt_spacing *= sx;
@@ -1089,6 +1093,7 @@ impl Pipeline {
             grid_width: w,
             grid_height: h,
             labels: grid.num_labels(),
+            image_labels: labels_present(original),
             sampled_vertices: segmented.inserted,
             merged_regions: merged.regions,
             merged_area: merged.area,
@@ -1753,6 +1758,11 @@ impl MeshOptions {
 
 /// Vertices, elements and labels of a mesh.
 type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
+
+/// How many labels of `grid` have a pixel.
+fn labels_present(grid: &LabelGrid) -> usize {
+    grid.counts().iter().filter(|&&n| n > 0).count()
+}
 
 /// How many pixels of `cleaned` have a region other than in `grid`. Labels are renumbered
 /// when regions vanish, so regions are compared by name (each name given one number first,

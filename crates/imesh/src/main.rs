@@ -596,11 +596,12 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         let c = &report.counts;
         let q = &report.quality;
         println!(
-            "{}: {}×{} px, {} labels → {} ({} vertices, {} quads, {} triangles) in {:.3} s",
+            "{}: {}×{} px, {} label{} → {} ({} vertices, {} quads, {} triangles) in {:.3} s",
             args.image.display(),
             c.width,
             c.height,
-            c.labels,
+            c.image_labels,
+            if c.image_labels == 1 { "" } else { "s" },
             output.display(),
             c.vertices,
             c.quads,
@@ -642,6 +643,9 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
                 c.blunted_area_px
             );
         }
+        for note in clean_up_notes(c, report.label_agreement) {
+            println!("{note}");
+        }
         if c.reduction > 1 {
             println!(
                 "meshed on a {}×{} grid of cells of about {f}×{f} px (--reduction 1 meshes every pixel)",
@@ -652,6 +656,42 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Label agreement under which the command says how much the clean-up relabelled.
+const LOW_AGREEMENT: f64 = 0.9;
+
+/// What the clean-up cost, when a user would want to know: labels of the image that no element
+/// carries, and a label agreement under [`LOW_AGREEMENT`].
+fn clean_up_notes(c: &imesh::Counts, label_agreement: f64) -> Vec<String> {
+    let quads = if c.quad_size > 0.0 {
+        format!("the {:.1} px quads", c.quad_size)
+    } else {
+        "the mesh".to_string()
+    };
+    let keep = "a smaller --size, or --majority 0 --min-width 0, keeps more of them";
+    let mut notes = Vec::new();
+    if c.meshed_labels < c.image_labels {
+        let gone = c.image_labels - c.meshed_labels;
+        let (has, their) = if gone == 1 {
+            ("has", "its")
+        } else {
+            ("have", "their")
+        };
+        notes.push(format!(
+            "{gone} of the image's {} labels {has} no elements: {their} regions were thinner or smaller than {quads} can follow, and were merged into their neighbours ({keep})",
+            c.image_labels
+        ));
+    }
+    let pixels = f64::from(c.grid_width) * f64::from(c.grid_height);
+    if label_agreement < LOW_AGREEMENT && c.cleaned_pixels > 0 && pixels > 0.0 {
+        notes.push(format!(
+            "label agreement is under {:.0} %: the clean-up relabelled {:.1} % of the pixels, specks, notches and strips thinner than {quads} can follow ({keep})",
+            100.0 * LOW_AGREEMENT,
+            100.0 * c.cleaned_pixels as f64 / pixels
+        ));
+    }
+    notes
 }
 
 /// Image files of a folder, sorted by name.

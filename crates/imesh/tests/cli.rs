@@ -864,3 +864,69 @@ fn the_forced_corner_note_names_only_sharp_corners() {
         );
     }
 }
+
+/// One-pixel lines every third row are thinner than the smallest automatic quads: the clean-up
+/// merges them all into the background, and the command says that a label of the image has no
+/// elements and how many pixels were relabelled, with the options that keep them. With those
+/// options the lines are meshed and the notes are gone; a square region needs no note.
+#[test]
+fn the_command_says_when_the_clean_up_drops_a_label() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut lines = image::GrayImage::new(30, 30);
+    for (_, y, p) in lines.enumerate_pixels_mut() {
+        p.0 = [if y % 3 == 0 { 255 } else { 0 }];
+    }
+    lines.save(dir.path().join("lines.png")).unwrap();
+    let dropped = "1 of the image's 2 labels has no elements";
+    let relabelled = "the clean-up relabelled 33.3 % of the pixels";
+    let out = imesh(
+        &["mesh", "lines.png", "-o", "out.msh", "--report", "r.json"],
+        dir.path(),
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{said}");
+    assert!(said.contains("30×30 px, 2 labels"), "{said}");
+    assert!(
+        said.contains(dropped) && said.contains(relabelled),
+        "{said}"
+    );
+    assert!(said.contains("--majority 0 --min-width 0"), "{said}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["counts"]["image_labels"], 2);
+    assert_eq!(report["counts"]["meshed_labels"], 1);
+    let out = imesh(
+        &[
+            "mesh",
+            "lines.png",
+            "-o",
+            "out.msh",
+            "--majority",
+            "0",
+            "--min-width",
+            "0",
+        ],
+        dir.path(),
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{said}");
+    assert!(
+        !said.contains("has no elements") && !said.contains("relabelled"),
+        "{said}"
+    );
+    let mut square = image::GrayImage::new(24, 24);
+    for (x, y, p) in square.enumerate_pixels_mut() {
+        p.0 = [if (6..18).contains(&x) && (6..18).contains(&y) {
+            255
+        } else {
+            0
+        }];
+    }
+    square.save(dir.path().join("square.png")).unwrap();
+    let out = imesh(&["mesh", "square.png", "-o", "out.msh"], dir.path());
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && said.contains("2 labels") && !said.contains("no elements"),
+        "{said}"
+    );
+}
