@@ -251,7 +251,7 @@ fn shortfall(quads: &[u32], points: &[Point], setup: &Setup, bar: f64) -> f64 {
             return f64::INFINITY;
         };
         if s < bar {
-            let j = imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y]));
+            let j = crate::energy::jacobian_under(&p, bar);
             shape += (bar - s) * (bar - s);
             jacobian += (bar - j).max(0.0).powi(2);
         }

@@ -348,8 +348,8 @@ impl Setup<'_> {
             && shape >= self.shape_floors[quad]
             && (jacobian == f64::NEG_INFINITY
                 || shape >= jacobian + JACOBIAN_MARGIN
-                || imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y])) >= jacobian))
-            .then_some((s, shape))
+                || energy::jacobian_at_least(p, jacobian)))
+        .then_some((s, shape))
     }
 
     /// The energy term of quad `p` and its gradient with respect to each corner (`None` where
@@ -761,6 +761,34 @@ mod tests {
                 prop_assert_eq!(ours.to_bits(), verdict.to_bits(), "{:?}", p);
             } else {
                 prop_assert!(ours < SURE_SHAPE, "{:?}: {}", p, ours);
+            }
+        }
+
+        /// The quick scaled-Jacobian tests give Verdict's answers on every valid quad, at any
+        /// scale and offset, for bounds on and a few ulps either side of Verdict's value (where
+        /// the quick value cannot tell) and far from it (where it does).
+        #[test]
+        fn quick_jacobian_tests_answer_as_verdict(
+            corners in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 4),
+            thin in 0.0f64..1.0,
+            scale in 1e-3f64..1e3, offset in -1e4f64..1e4,
+            ulps in -3i64..=3, far in -1.0f64..1.0,
+        ) {
+            // A jittered unit square squeezed towards a sliver, mostly valid.
+            let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+            let p: [Point; 4] = std::array::from_fn(|i| {
+                Point::new(
+                    offset + scale * (square[i].0 + 0.4 * corners[i].0),
+                    offset / 3.0 + scale * (1.0 - thin) * (square[i].1 + 0.4 * corners[i].1),
+                )
+            });
+            prop_assume!(is_valid(&p));
+            let verdict = energy::verdict_jacobian(&p);
+            let near = f64::from_bits((verdict.to_bits() as i64 + ulps) as u64);
+            for bound in [verdict, near, far, verdict + 1e-7, verdict - 1e-7] {
+                prop_assert_eq!(energy::jacobian_at_least(&p, bound), verdict >= bound, "{:?} {}", p, bound);
+                let under = energy::jacobian_under(&p, bound);
+                prop_assert_eq!(under.min(bound).to_bits(), verdict.min(bound).to_bits(), "{:?} {}", p, bound);
             }
         }
 

@@ -256,8 +256,7 @@ pub(crate) fn corners_value(
         // The scaled Jacobian is at least the shape: only a shape under the bar can leave it
         // there.
         if s < bar {
-            let j = imesh_quality::quad::scaled_jacobian(&p.map(|p| [p.x, p.y]));
-            jacobian = jacobian.min(j);
+            jacobian = jacobian.min(crate::energy::jacobian_under(&p, jacobian));
         }
     }
     Some((jacobian, shape))
