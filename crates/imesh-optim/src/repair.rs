@@ -90,6 +90,10 @@ pub(crate) fn repair(
     let vars = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
     let vertices = &mut mesh.vertices;
     let mut moved = vec![false; vars.len()];
+    // A search is a function of the corners of the quads it scores: one that found no move is
+    // not run again until one of those corners has moved (the same result, unsearched).
+    let mut since = Unchanged::new(vertices.len());
+    let mut vertex_failed = vec![NEVER; vars.len()];
     let mut poor_quads = first;
     for pass in 0..PASSES {
         if pass > 0 {
@@ -109,9 +113,16 @@ pub(crate) fn repair(
         }
         let mut any = false;
         for i in (0..vars.len()).filter(|&i| wanted[i]) {
+            let quads = vars.quads.row(i);
+            if since.unchanged(vertex_failed[i], quads, setup.quads) {
+                continue;
+            }
             if improve(&vars, i, vertices, setup, bar) {
                 moved[i] = true;
                 any = true;
+                since.moved(&[vars.ids[i] as usize]);
+            } else {
+                vertex_failed[i] = since.now();
             }
         }
         if !any {
@@ -126,6 +137,7 @@ pub(crate) fn repair(
     for (i, &v) in vars.ids.iter().enumerate() {
         variable_of[v as usize] = i as u32;
     }
+    let mut quad_failed = vec![NEVER; setup.quads.len()];
     for _ in 0..PASSES {
         let mut any = false;
         for q in poor(vertices) {
@@ -143,6 +155,9 @@ pub(crate) fn repair(
                 .collect();
             quads.sort_unstable();
             quads.dedup();
+            if since.unchanged(quad_failed[q as usize], &quads, setup.quads) {
+                continue;
+            }
             let together: Vec<u32> = (1..1u32 << free.len())
                 .filter(|m| m.count_ones() >= 2)
                 .collect();
@@ -151,6 +166,9 @@ pub(crate) fn repair(
                     moved[variable_of[v] as usize] = true;
                 }
                 any = true;
+                since.moved(&free);
+            } else {
+                quad_failed[q as usize] = since.now();
             }
         }
         if !any {
@@ -158,6 +176,49 @@ pub(crate) fn repair(
         }
     }
     moved.iter().filter(|&&m| m).count()
+}
+
+/// A search that has not failed yet.
+const NEVER: u32 = u32::MAX;
+
+/// Which vertices moved since when: a clock that ticks at every move, and per vertex the tick
+/// of its last move.
+struct Unchanged {
+    clock: u32,
+    moved_at: Vec<u32>,
+}
+
+impl Unchanged {
+    fn new(vertices: usize) -> Self {
+        Self {
+            clock: 0,
+            moved_at: vec![0; vertices],
+        }
+    }
+
+    /// The time now, to stamp a search that found no move.
+    fn now(&self) -> u32 {
+        self.clock
+    }
+
+    /// Vertices `moved` have just moved.
+    fn moved(&mut self, moved: &[usize]) {
+        self.clock += 1;
+        for &v in moved {
+            self.moved_at[v] = self.clock;
+        }
+    }
+
+    /// True when a search that found no move at time `failed` (or [`NEVER`]) would find none
+    /// again: no corner of `quads` (of `corners`) has moved since.
+    fn unchanged(&self, failed: u32, quads: &[u32], corners: &[[u32; 4]]) -> bool {
+        failed != NEVER
+            && quads.iter().all(|&q| {
+                corners[q as usize]
+                    .iter()
+                    .all(|&u| self.moved_at[u as usize] <= failed)
+            })
+    }
 }
 
 /// Compass search for vertex variable `i`: the smallest of its quads' scaled Jacobians as high
@@ -284,7 +345,7 @@ pub(crate) fn stalling_grid() -> Vec<Point> {
 
 #[cfg(test)]
 mod tests {
-    use super::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
+    use super::{compass, stalling_grid, Unchanged, NEVER, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::{LocalSolver, Metric, Setup};
     use imesh_geom::Point;
 
@@ -298,6 +359,24 @@ mod tests {
             .iter()
             .map(|q| imesh_quality::quad::scaled_jacobian(&corners(q, vertices)))
             .fold(f64::INFINITY, f64::min)
+    }
+
+    /// A failed search is skipped until a corner of one of its quads moves, and only then: not
+    /// before it has failed, nor after a move of a vertex elsewhere.
+    #[test]
+    fn a_failed_search_is_skipped_until_its_corners_move() {
+        let corners = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
+        let mut since = Unchanged::new(10);
+        assert!(!since.unchanged(NEVER, &[0, 1], &corners));
+        since.moved(&[9]);
+        let failed = since.now();
+        assert!(since.unchanged(failed, &[0, 1], &corners));
+        since.moved(&[6, 9]); // corner of quad 2 only
+        assert!(since.unchanged(failed, &[0, 1], &corners));
+        assert!(!since.unchanged(failed, &[0, 2], &corners));
+        since.moved(&[5]);
+        assert!(!since.unchanged(failed, &[1], &corners));
+        assert!(since.unchanged(since.now(), &[1], &corners));
     }
 
     /// Four quads on a 3 × 3 grid of points, all pinned but the middle one and its right
