@@ -89,16 +89,21 @@ const QUICK_JACOBIAN_SLACK: f64 = 1e-9;
 /// The scaled Jacobian of a counter-clockwise quad `p` the quick way: `α / √(|a|² |b|²)` at
 /// each corner on the raw coordinates, without Verdict's bounding box (a square root and
 /// four divisions fewer, and no `hypot`). Equal to Verdict's up to rounding where it is at least
-/// [`QUICK_JACOBIAN_FLOOR`]; NaN or anything where the quad is degenerate.
+/// [`QUICK_JACOBIAN_FLOOR`]; NaN where a corner is not finite (a zero edge, or lengths out of
+/// the floating-point range), which leaves the decision to Verdict.
 #[inline]
 fn quick_jacobian(p: &[Point; 4]) -> f64 {
     let e = [p[1] - p[0], p[2] - p[1], p[3] - p[2], p[0] - p[3]];
     let len2 = e.map(|v| v.x * v.x + v.y * v.y);
-    let corner = |k: usize| {
+    let corner = [0, 1, 2, 3].map(|k| {
         let (a, b) = (e[(k + 3) % 4], e[k]);
         (a.x * b.y - a.y * b.x) / (len2[(k + 3) % 4] * len2[k]).sqrt()
-    };
-    least(least(least(corner(0), corner(1)), corner(2)), corner(3))
+    });
+    if corner.iter().all(|c| c.is_finite()) {
+        least(least(least(corner[0], corner[1]), corner[2]), corner[3])
+    } else {
+        f64::NAN
+    }
 }
 
 /// Whether the quick scaled Jacobian `quick` says on which side of `bound` Verdict's is: `Some`
