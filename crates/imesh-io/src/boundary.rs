@@ -1,6 +1,6 @@
 //! The boundaries of a labelled mesh: edges between two labels, and the domain border.
 
-use std::collections::HashMap;
+use rayon::prelude::*;
 
 use crate::SegmentedMeshData;
 
@@ -53,39 +53,37 @@ pub fn sanitize(name: &str) -> String {
 
 /// Every boundary of `mesh`, sorted by labels; each edge once, in the order of the elements.
 pub fn boundaries(mesh: &SegmentedMeshData) -> Vec<Boundary> {
-    // Edge (low, high) → labels of the elements on it, in order of appearance.
-    let mut sides: HashMap<[u32; 2], (Vec<u32>, usize)> = HashMap::new();
-    let mut order = 0usize;
+    // Every element side as (edge, when it was met, label), sorted: the sides of one edge are
+    // then consecutive, the first met first. A sort of plain tuples, not a map of edges to
+    // growing lists (aloe's 1.4 M sides: 0.3 s that way).
+    let mut sides: Vec<([u32; 2], usize, u32)> = Vec::with_capacity(4 * mesh.elements.len());
     for (e, &l) in mesh.elements.iter().zip(&mesh.labels) {
         let c = e.corners();
         for i in 0..c.len() {
             let (a, b) = (c[i], c[(i + 1) % c.len()]);
-            let entry = sides.entry([a.min(b), a.max(b)]).or_insert_with(|| {
-                order += 1;
-                (Vec::new(), order)
-            });
-            entry.0.push(l);
+            sides.push(([a.min(b), a.max(b)], sides.len(), l));
         }
     }
-    let mut groups: HashMap<[u32; 2], Vec<(usize, [u32; 2])>> = HashMap::new();
-    for (edge, (labels, seen)) in sides {
-        let key = match labels.as_slice() {
-            [a] => [*a, OUTSIDE],
-            [a, b] if a != b => [*a.min(b), *a.max(b)],
-            _ => continue,
-        };
-        groups.entry(key).or_default().push((seen, edge));
-    }
-    let mut out: Vec<Boundary> = groups
-        .into_iter()
-        .map(|(labels, mut edges)| {
-            edges.sort_unstable();
-            Boundary {
-                labels,
-                edges: edges.into_iter().map(|(_, e)| e).collect(),
-            }
+    sides.par_sort_unstable();
+    // An edge with one side is on the border, with two of different labels between them;
+    // anything else is inside a region.
+    let mut found: Vec<([u32; 2], usize, [u32; 2])> = sides
+        .chunk_by(|x, y| x.0 == y.0)
+        .filter_map(|edge| {
+            let labels = match edge {
+                [(_, _, a)] => [*a, OUTSIDE],
+                [(_, _, a), (_, _, b)] if a != b => [*a.min(b), *a.max(b)],
+                _ => return None,
+            };
+            Some((labels, edge[0].1, edge[0].0))
         })
         .collect();
-    out.sort_by_key(|b| b.labels);
-    out
+    found.par_sort_unstable();
+    found
+        .chunk_by(|x, y| x.0 == y.0)
+        .map(|edges| Boundary {
+            labels: edges[0].0,
+            edges: edges.iter().map(|&(_, _, e)| e).collect(),
+        })
+        .collect()
 }

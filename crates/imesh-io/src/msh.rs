@@ -67,13 +67,18 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         let _ = writeln!(s, "{} {} 0", p[0], p[1]);
     }
     let _ = writeln!(s, "$EndNodes");
-    // Blocks: per label, per element type.
+    // Blocks: per label, per element type (triangles first), in one pass over the elements.
+    let labels = used.iter().max().map_or(0, |&l| l as usize + 1);
+    let mut members: Vec<[Vec<usize>; 2]> = vec![Default::default(); labels];
+    for (i, (e, &l)) in mesh.elements.iter().zip(&mesh.labels).enumerate() {
+        members[l as usize][usize::from(gmsh_type(e) == 3)].push(i);
+    }
     let mut blocks: Vec<(u32, u32, Vec<usize>)> = Vec::new();
     for &l in &used {
-        for kind in [2u32, 3] {
-            let members: Vec<usize> = (0..mesh.elements.len())
-                .filter(|&i| mesh.labels[i] == l && gmsh_type(&mesh.elements[i]) == kind)
-                .collect();
+        for (kind, members) in [2u32, 3]
+            .into_iter()
+            .zip(std::mem::take(&mut members[l as usize]))
+        {
             if !members.is_empty() {
                 blocks.push((l, kind, members));
             }

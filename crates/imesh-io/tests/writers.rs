@@ -176,6 +176,61 @@ fn boundaries_separate_labels_and_the_border() {
     assert_eq!(b[0].name(&mesh), "even_odd");
 }
 
+/// The boundaries the slow way: each edge's labels in a map, the edges in the order first met.
+fn boundaries_by_map(mesh: &SegmentedMeshData) -> Vec<(u32, u32, Vec<[u32; 2]>)> {
+    let mut sides: std::collections::BTreeMap<[u32; 2], (usize, Vec<u32>)> = Default::default();
+    let mut met = 0;
+    for (e, &l) in mesh.elements.iter().zip(&mesh.labels) {
+        let c = e.corners();
+        for i in 0..c.len() {
+            let (a, b) = (c[i], c[(i + 1) % c.len()]);
+            let side = sides.entry([a.min(b), a.max(b)]).or_insert_with(|| {
+                met += 1;
+                (met, Vec::new())
+            });
+            side.1.push(l);
+        }
+    }
+    let mut found: Vec<([u32; 2], usize, [u32; 2])> = Vec::new();
+    for (edge, (first, labels)) in sides {
+        match labels[..] {
+            [a] => found.push(([a, OUTSIDE], first, edge)),
+            [a, b] if a != b => found.push(([a.min(b), a.max(b)], first, edge)),
+            _ => {}
+        }
+    }
+    found.sort_unstable();
+    let mut out: Vec<(u32, u32, Vec<[u32; 2]>)> = Vec::new();
+    for (labels, _, edge) in found {
+        match out.last_mut() {
+            Some(last) if [last.0, last.1] == labels => last.2.push(edge),
+            _ => out.push((labels[0], labels[1], vec![edge])),
+        }
+    }
+    out
+}
+
+proptest! {
+    /// On grids of triangles labelled at random, [`boundaries`] lists what a map of every edge's
+    /// sides does: the same boundaries, the same edges, in the order first met.
+    #[test]
+    fn boundaries_are_those_of_a_map_of_edges(
+        w in 1u32..7, h in 1u32..7, seed in proptest::collection::vec(0u32..3, 72),
+    ) {
+        let mut mesh = grid_mesh(w, h);
+        for (k, l) in mesh.labels.iter_mut().enumerate() {
+            *l = seed[k % seed.len()];
+        }
+        mesh.label_names = vec!["a".into(), "b".into(), "c".into()];
+        mesh.label_colours = vec![[0, 0, 0]; 3];
+        let ours: Vec<(u32, u32, Vec<[u32; 2]>)> = boundaries(&mesh)
+            .into_iter()
+            .map(|b| (b.labels[0], b.labels[1], b.edges))
+            .collect();
+        prop_assert_eq!(ours, boundaries_by_map(&mesh));
+    }
+}
+
 #[test]
 fn abaqus_has_element_sets_per_label_and_node_sets_per_boundary() {
     let mesh = grid_mesh(2, 1);
