@@ -115,12 +115,17 @@ fn ceil_div(n: i64, d: i64) -> i64 {
     -(-n).div_euclid(d)
 }
 
+/// `⌊n / d⌋`, in 64 bits where both fit (always, for images of under 2²⁹ pixels a side):
+/// a 128-bit division is a library call, several times slower.
 fn floor_div_128(n: i128, d: i128) -> i128 {
-    n.div_euclid(d)
+    match (i64::try_from(n), i64::try_from(d)) {
+        (Ok(n), Ok(d)) => i128::from(n.div_euclid(d)),
+        _ => n.div_euclid(d),
+    }
 }
 
 fn ceil_div_128(n: i128, d: i128) -> i128 {
-    -(-n).div_euclid(d)
+    -floor_div_128(-n, d)
 }
 
 #[cfg(test)]
@@ -152,6 +157,21 @@ mod tests {
             }
         }
         lo <= hi
+    }
+
+    proptest::proptest! {
+        /// The divisions take the 64-bit path where they can and give the 128-bit results,
+        /// near zero, near the 64-bit limits and beyond them.
+        #[test]
+        fn divisions_match_128_bit_ones(
+            n in proptest::prop_oneof![-1000i128..1000, proptest::num::i128::ANY],
+            d in proptest::prop_oneof![1i128..100, 1i128..=i128::from(i64::MAX), 1i128..i128::MAX],
+        ) {
+            proptest::prop_assert_eq!(floor_div_128(n, d), n.div_euclid(d));
+            if n > i128::MIN {
+                proptest::prop_assert_eq!(ceil_div_128(n, d), -(-n).div_euclid(d));
+            }
+        }
     }
 
     #[test]
