@@ -3,6 +3,7 @@
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
+use rayon::prelude::*;
 
 use crate::graph::CurveGraph;
 
@@ -293,23 +294,22 @@ pub(crate) fn grid_for(g: &CurveGraph) -> Grid {
     Grid::new(used, g.edges().len() / 4)
 }
 
-/// The first pair of conflicting edges of `g`, if any.
+/// The first pair of conflicting edges of `g`, if any: in the first cell that has one, the
+/// first in that cell's order (the cells searched in parallel, the same pair found).
 pub(crate) fn first_crossing(g: &CurveGraph) -> Option<[u32; 2]> {
     let grid = grid_for(g);
     let cells = edge_cells(g, &grid);
-    for c in 0..grid.len() {
+    (0..grid.len()).into_par_iter().find_map_first(|c| {
         let list = cells.get(c);
-        for (k, &e) in list.iter().enumerate() {
-            for &f in &list[k + 1..] {
-                if conflict(
+        list.iter().enumerate().find_map(|(k, &e)| {
+            list[k + 1..].iter().find_map(|&f| {
+                conflict(
                     g.points(),
                     g.edges()[e as usize].ends,
                     g.edges()[f as usize].ends,
-                ) {
-                    return Some([e.min(f), e.max(f)]);
-                }
-            }
-        }
-    }
-    None
+                )
+                .then(|| [e.min(f), e.max(f)])
+            })
+        })
+    })
 }
