@@ -52,6 +52,19 @@ fn msh_counts(text: &str) -> (usize, usize, usize, usize) {
     )
 }
 
+/// Saves a 24 × 24 image of a white square, `side` wide in both directions, on black.
+fn save_square(path: &Path, side: std::ops::Range<u32>) {
+    let mut square = image::GrayImage::new(24, 24);
+    for (x, y, p) in square.enumerate_pixels_mut() {
+        p.0 = [if side.contains(&x) && side.contains(&y) {
+            255
+        } else {
+            0
+        }];
+    }
+    square.save(path).unwrap();
+}
+
 #[test]
 fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     let dir = tempfile::tempdir().unwrap();
@@ -842,15 +855,7 @@ fn the_forced_corner_note_names_only_sharp_corners() {
     );
     // A square of one label in another: the image's corners and the square's are right angles,
     // and a one-pixel image's four corners too.
-    let mut square = image::GrayImage::new(24, 24);
-    for (x, y, p) in square.enumerate_pixels_mut() {
-        p.0 = [if (8..16).contains(&x) && (8..16).contains(&y) {
-            255
-        } else {
-            0
-        }];
-    }
-    square.save(dir.path().join("square.png")).unwrap();
+    save_square(&dir.path().join("square.png"), 8..16);
     image::GrayImage::new(1, 1)
         .save(dir.path().join("one.png"))
         .unwrap();
@@ -914,15 +919,7 @@ fn the_command_says_when_the_clean_up_drops_a_label() {
         !said.contains("has no elements") && !said.contains("relabelled"),
         "{said}"
     );
-    let mut square = image::GrayImage::new(24, 24);
-    for (x, y, p) in square.enumerate_pixels_mut() {
-        p.0 = [if (6..18).contains(&x) && (6..18).contains(&y) {
-            255
-        } else {
-            0
-        }];
-    }
-    square.save(dir.path().join("square.png")).unwrap();
+    save_square(&dir.path().join("square.png"), 6..18);
     let out = imesh(&["mesh", "square.png", "-o", "out.msh"], dir.path());
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
