@@ -923,7 +923,9 @@ impl Pipeline {
         self.check_options()?;
         let start = Instant::now();
         let Some((factor, reduced)) = self.reduced(grid) else {
-            return self.mesh_grid(grid, classified);
+            let mut result = self.mesh_grid(grid, classified)?;
+            result.report.counts.image_labels = labels_present(grid);
+            return Ok(result);
         };
         let reducing = start.elapsed().as_secs_f64();
         let (sx, sy) = (
@@ -936,6 +938,7 @@ impl Pipeline {
         };
         let mut result = on_cells.mesh_grid(&reduced, classified + reducing)?;
         self.enlarge(&mut result, grid, factor)?;
+        result.report.counts.image_labels = labels_present(grid);
         result.report.seconds.total = classified + start.elapsed().as_secs_f64();
         Ok(result)
     }
@@ -1002,7 +1005,6 @@ impl Pipeline {
         (mesh.width, mesh.height) = (original.width(), original.height());
         (counts.width, counts.height) = (mesh.width, mesh.height);
         counts.reduction = factor;
-        counts.image_labels = labels_present(original);
         let (sx, sy) = (w / cw, h / ch);
         counts.quad_size *= sx;
         counts.dt_spacing *= sx;
@@ -1093,7 +1095,6 @@ impl Pipeline {
             grid_width: w,
             grid_height: h,
             labels: grid.num_labels(),
-            image_labels: labels_present(original),
             sampled_vertices: segmented.inserted,
             merged_regions: merged.regions,
             merged_area: merged.area,

@@ -669,7 +669,11 @@ fn clean_up_notes(c: &imesh::Counts, label_agreement: f64) -> Vec<String> {
     } else {
         "the mesh".to_string()
     };
-    let keep = "a smaller --size, or --majority 0 --min-width 0, keeps more of them";
+    let keep = if c.reduction > 1 {
+        "a smaller --size, --reduction 1, or --majority 0 --min-width 0, keeps more of them"
+    } else {
+        "a smaller --size, or --majority 0 --min-width 0, keeps more of them"
+    };
     let mut notes = Vec::new();
     if c.meshed_labels < c.image_labels {
         let gone = c.image_labels - c.meshed_labels;
