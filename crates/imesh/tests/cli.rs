@@ -580,6 +580,18 @@ fn batch_meshes_a_folder_and_reports_failures_without_stopping() {
         "{table}"
     );
     assert_eq!(table.matches("FAILED").count(), 1, "{table}");
+    // Labels meshed of the image's.
+    let row = |name: &str| {
+        table
+            .lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_default()
+    };
+    assert!(row("matplotlib-s1045_mri.png").contains(" 2/2 "), "{table}");
+    assert!(
+        row("pyvista-channels_z050_labels.png").contains(" 5/5 "),
+        "{table}"
+    );
     assert!(String::from_utf8_lossy(&out.stderr).contains("1 of 3 images failed"));
     for stem in ["matplotlib-s1045_mri", "pyvista-channels_z050_labels"] {
         assert!(dir.path().join("out").join(format!("{stem}.vtu")).exists());
