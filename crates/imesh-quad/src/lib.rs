@@ -151,7 +151,9 @@ pub struct Remesh {
 pub struct RemeshSeconds {
     /// DT': the conforming Delaunay triangulation of G' and its refinement.
     pub triangulation: f64,
-    /// Pairing, the control net and the templates.
+    /// Pairing DT''s triangles into M.
+    pub pairing: f64,
+    /// The control net and the templates.
     pub templates: f64,
     /// Boundary adaptation.
     pub adaptation: f64,
@@ -183,6 +185,7 @@ pub fn remesh(
     let dt = RegionTriangulation::new(g, &options.density)?;
     let triangulation = clock.elapsed().as_secs_f64();
     let elements = ElementMesh::pair(&dt.triangulation, options.pairing);
+    let pairing = clock.elapsed().as_secs_f64() - triangulation;
     let quads = elements.quad_count(options.level);
     if quads > options.max_quads {
         return Err(QuadError::TooManyQuads {
@@ -193,13 +196,14 @@ pub fn remesh(
     let mut net = ControlNet::straight(&dt.triangulation, &elements);
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();
-    let templates = clock.elapsed().as_secs_f64() - triangulation;
+    let templates = clock.elapsed().as_secs_f64() - triangulation - pairing;
     let (adaptation, edge_curves) = adapt(&dt, g, curves, &elements, &mut net, &mut mesh);
     mesh.snap_to_border(&dt.triangulation, &elements);
     let seconds = RemeshSeconds {
         triangulation,
+        pairing,
         templates,
-        adaptation: clock.elapsed().as_secs_f64() - triangulation - templates,
+        adaptation: clock.elapsed().as_secs_f64() - triangulation - pairing - templates,
     };
     Ok(Remesh {
         seconds,

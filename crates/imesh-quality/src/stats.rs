@@ -8,13 +8,19 @@ use serde::{Deserialize, Serialize};
 /// Jacobian, minimum angle); use [`Statistics::max`] for the others. The variance is the sample
 /// variance (n − 1), as `vtkMeshQuality` reports it.
 ///
+/// In JSON the count below the threshold also has a key naming the threshold, as the report's
+/// stable keys have it (DESIGN.md §6): `below_0_2` for a threshold of 0.2, `below_45` for 45.
+///
 /// ```
 /// use imesh_quality::Statistics;
 /// let s = Statistics::of(&[1.0, 0.5, 0.1, 0.9], 0.2);
 /// assert_eq!((s.min, s.max, s.count, s.below), (0.1, 1.0, 4, 1));
 /// assert!((s.mean - 0.625).abs() < 1e-15);
+/// let json = serde_json::to_value(s)?;
+/// assert_eq!((&json["below_0_2"], &json["below"]), (&1.into(), &1.into()));
+/// # Ok::<(), serde_json::Error>(())
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 pub struct Statistics {
     /// Smallest value (NaN-free input assumed; NaNs are skipped).
     pub min: f64,
@@ -32,7 +38,35 @@ pub struct Statistics {
     pub below: usize,
 }
 
+impl Serialize for Statistics {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(8))?;
+        map.serialize_entry("min", &self.min)?;
+        map.serialize_entry("max", &self.max)?;
+        map.serialize_entry("mean", &self.mean)?;
+        map.serialize_entry("variance", &self.variance)?;
+        map.serialize_entry("count", &self.count)?;
+        map.serialize_entry("threshold", &self.threshold)?;
+        map.serialize_entry("below", &self.below)?;
+        map.serialize_entry(&self.below_key(), &self.below)?;
+        map.end()
+    }
+}
+
 impl Statistics {
+    /// The JSON key naming the count below the threshold: `below_0_2` for 0.2, `below_135` for
+    /// 135 (the threshold as Rust prints it, its point an underscore).
+    ///
+    /// ```
+    /// use imesh_quality::Statistics;
+    /// assert_eq!(Statistics::of(&[], 0.3).below_key(), "below_0_3");
+    /// assert_eq!(Statistics::of(&[], 45.0).below_key(), "below_45");
+    /// ```
+    pub fn below_key(&self) -> String {
+        format!("below_{}", self.threshold).replace(['.', '-'], "_")
+    }
+
     /// Statistics of `values` (NaNs skipped), counting those below `threshold`.
     pub fn of(values: &[f64], threshold: f64) -> Self {
         let mut s = Self {

@@ -430,19 +430,25 @@ pub struct StageSeconds {
     pub refine: f64,
     /// Curve simplification and fitting (quads).
     pub curves: f64,
-    /// DT', pairing, templates and adaptation (quads): the sum of the next three.
+    /// DT', pairing, templates and adaptation (quads): the next four, and any retry at another
+    /// lattice scale.
     pub quads: f64,
     /// DT': the conforming Delaunay triangulation of the simplified boundaries (quads).
-    pub dt: f64,
-    /// Pairing, the control net and the templates (quads).
-    pub pairing_templates: f64,
+    pub triangulate: f64,
+    /// Pairing DT''s triangles into the mixed mesh M (quads).
+    pub pairing: f64,
+    /// The control net and the templates (quads).
+    pub templates: f64,
     /// Boundary adaptation (quads).
-    pub adaptation: f64,
+    pub adapt: f64,
     /// Optimisation of the quads.
     pub optimise: f64,
     /// Invariant checks and quality measurement.
     pub check: f64,
-    /// All stages.
+    /// Writing the mesh file: set by whoever writes it (the `imesh` program), 0 from the
+    /// pipeline alone.
+    pub write: f64,
+    /// All stages (the write's included once it is set).
     pub total: f64,
 }
 
@@ -1499,9 +1505,10 @@ impl Pipeline {
             }
         }
         seconds.quads = start.elapsed().as_secs_f64() - fitting;
-        seconds.dt = r.seconds.triangulation;
-        seconds.pairing_templates = r.seconds.templates;
-        seconds.adaptation = r.seconds.adaptation;
+        seconds.triangulate = r.seconds.triangulation;
+        seconds.pairing = r.seconds.pairing;
+        seconds.templates = r.seconds.templates;
+        seconds.adapt = r.seconds.adaptation;
         counts.simplified_edges = graph.edges().len();
         counts.dt_triangles = r.dt.triangulation.num_triangles();
         counts.dt_spacing = spacing.unwrap_or(0.0);

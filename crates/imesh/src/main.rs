@@ -375,6 +375,22 @@ fn write_mesh(
     }
 }
 
+/// [`write_mesh`], its seconds added to the report's (`timings_s.write`, and the total).
+fn write_timed_mesh(
+    output: &Path,
+    format: &str,
+    mesh: &SegmentedMeshData,
+    frame: &Frame,
+    report: &mut imesh::Report,
+) -> Result<(), String> {
+    let clock = std::time::Instant::now();
+    write_mesh(output, format, mesh, frame)?;
+    let seconds = clock.elapsed().as_secs_f64();
+    report.seconds.write = seconds;
+    report.seconds.total += seconds;
+    Ok(())
+}
+
 fn write_report(path: &Path, report: &imesh::Report) -> Result<(), String> {
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())?;
     write_atomic(path, json.as_bytes()).map_err(|e| e.to_string())
@@ -545,14 +561,14 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     bar.finish_and_clear();
     let PipelineResult {
         mesh,
-        report,
+        mut report,
         stages,
         label_picture,
     } = result.map_err(|e| e.to_string())?;
     if let Some(dir) = &args.stages {
         write_stages(dir, &mesh, &stages, label_picture.as_ref())?;
     }
-    write_mesh(&output, &format, &mesh, &frame)?;
+    write_timed_mesh(&output, &format, &mesh, &frame, &mut report)?;
     if let Some(svg) = &args.svg {
         let options = if args.svg_over_image {
             let image = std::fs::canonicalize(&args.image)
@@ -749,10 +765,11 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let PipelineResult { mesh, report, .. } =
-                pipeline.run_path(image).map_err(|e| e.to_string())?;
+            let PipelineResult {
+                mesh, mut report, ..
+            } = pipeline.run_path(image).map_err(|e| e.to_string())?;
             let output = args.output.join(&stem).with_extension(&format);
-            write_mesh(&output, &format, &mesh, &frame)?;
+            write_timed_mesh(&output, &format, &mesh, &frame, &mut report)?;
             write_report(&args.output.join(format!("{stem}.json")), &report)?;
             Ok(report)
         })

@@ -131,7 +131,42 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
         hausdorff > 0.0 && hausdorff <= 2f64.max(cut) + 1e-9,
         "within the 2 px tolerance or the cut: {hausdorff}"
     );
-    assert!(report["timings_s"]["total"].as_f64().unwrap() > 0.0);
+    let seconds = &report["timings_s"];
+    let stage = |name: &str| {
+        seconds[name]
+            .as_f64()
+            .unwrap_or_else(|| panic!("timings_s.{name} in the report"))
+    };
+    let stages = [
+        "classify",
+        "sample",
+        "curves",
+        "triangulate",
+        "pairing",
+        "templates",
+        "adapt",
+        "optimise",
+        "write",
+    ];
+    // The stages are disjoint: together within the whole (which also holds the checks).
+    let sum: f64 = stages.iter().map(|&s| stage(s)).sum();
+    assert!(stage("write") > 0.0 && stage("optimise") > 0.0);
+    assert!(sum > 0.0 && sum <= stage("total") + 1e-9, "{sum} of {}", stage("total"));
+    for metric in ["shape_and_size", "shape", "scaled_jacobian"] {
+        let block = &report["quality"][metric];
+        assert_eq!(block["count"], report["counts"]["quads"]);
+        assert!(block["min"].as_f64().unwrap() <= block["mean"].as_f64().unwrap());
+        assert!(block["variance"].as_f64().unwrap() >= 0.0);
+    }
+    // Poor quads counted under the key DESIGN.md §6 names, with those of the other metrics
+    // under their own thresholds' keys.
+    let sas = &report["quality"]["shape_and_size"];
+    assert_eq!(sas["below_0_2"], sas["below"]);
+    assert_eq!(sas["threshold"], 0.2);
+    assert_eq!(
+        report["quality"]["scaled_jacobian"]["below_0_3"],
+        report["quality"]["scaled_jacobian"]["below"]
+    );
     assert_eq!(report["imesh_version"], env!("CARGO_PKG_VERSION"));
     assert!(report["input"]["path"]
         .as_str()
