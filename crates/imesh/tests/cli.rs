@@ -151,7 +151,11 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     // The stages are disjoint: together within the whole (which also holds the checks).
     let sum: f64 = stages.iter().map(|&s| stage(s)).sum();
     assert!(stage("write") > 0.0 && stage("optimise") > 0.0);
-    assert!(sum > 0.0 && sum <= stage("total") + 1e-9, "{sum} of {}", stage("total"));
+    assert!(
+        sum > 0.0 && sum <= stage("total") + 1e-9,
+        "{sum} of {}",
+        stage("total")
+    );
     for metric in ["shape_and_size", "shape", "scaled_jacobian"] {
         let block = &report["quality"][metric];
         assert_eq!(block["count"], report["counts"]["quads"]);
