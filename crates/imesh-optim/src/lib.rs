@@ -315,15 +315,20 @@ impl Setup<'_> {
     fn quality_and_area(&self, p: &[Point; 4]) -> (f64, f64, f64) {
         let shape = energy::shape(p);
         let area = energy::area(p);
-        let s = match self.metric {
+        (self.metric_of(shape, area), shape, area)
+    }
+
+    /// The metric of a quad of shape `shape` and signed area `area`.
+    #[inline]
+    fn metric_of(&self, shape: f64, area: f64) -> f64 {
+        match self.metric {
             Metric::Shape => shape,
             Metric::ShapeAndSize => {
                 let r = area / self.average_area;
                 let m = if r > 0.0 { r.min(1.0 / r) } else { 0.0 };
                 shape * m * m
             }
-        };
-        (s, shape, area)
+        }
     }
 
     /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
@@ -334,10 +339,64 @@ impl Setup<'_> {
             .map(|(s, _)| (1.0 - s) * (1.0 - s))
     }
 
+    /// [`Setup::quality_and_area`] of `N` quads at once (the same bits as one by one), lane by
+    /// lane so that the compiler can put the lanes side by side in vector registers.
+    #[inline]
+    pub fn qualities_and_areas<const N: usize>(
+        &self,
+        p: &[[Point; 4]; N],
+    ) -> ([f64; N], [f64; N], [f64; N]) {
+        let (shape, area) = energy::shapes_and_areas(p);
+        let s = match self.metric {
+            Metric::Shape => shape,
+            Metric::ShapeAndSize => {
+                // `metric_of`'s steps without its branch: the relative size of a quad of no
+                // positive area is computed and then dropped for 0.
+                let mut s = [0.0; N];
+                for l in 0..N {
+                    let r = area[l] / self.average_area;
+                    let m = r.min(1.0 / r);
+                    let m = if r > 0.0 { m } else { 0.0 };
+                    s[l] = shape[l] * m * m;
+                }
+                s
+            }
+        };
+        (s, shape, area)
+    }
+
+    /// [`Setup::term`] of quad `p` whose metric, [`energy::shape`] and [`energy::area`] are
+    /// known.
+    #[inline]
+    pub fn term_given(
+        &self,
+        quad: usize,
+        p: &[Point; 4],
+        s: f64,
+        shape: f64,
+        area: f64,
+    ) -> Option<f64> {
+        self.feasible_given(quad, p, s, shape, area)
+            .map(|(s, _)| (1.0 - s) * (1.0 - s))
+    }
+
     /// The metric and the shape of quad `p` when it is valid and above both floors.
     #[inline]
     fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
         let (s, shape, area) = self.quality_and_area(p);
+        self.feasible_given(quad, p, s, shape, area)
+    }
+
+    /// [`Setup::feasible_quality`] given the quad's metric, shape and area.
+    #[inline]
+    fn feasible_given(
+        &self,
+        quad: usize,
+        p: &[Point; 4],
+        s: f64,
+        shape: f64,
+        area: f64,
+    ) -> Option<(f64, f64)> {
         if !((shape >= SURE_SHAPE && area > 0.0) || is_valid(p)) {
             return None;
         }
@@ -689,6 +748,23 @@ mod tests {
         Ok(())
     }
 
+    /// A setup of one quad with no floors.
+    fn unit_setup() -> Setup<'static> {
+        Setup {
+            quads: &[[0, 1, 2, 3]],
+            metric: Metric::ShapeAndSize,
+            average_area: 1.0,
+            quality_floors: &[0.0],
+            shape_floors: &[0.0],
+            jacobian_floors: &[f64::NEG_INFINITY],
+            max_sweeps: 1,
+            tolerance: 0.0,
+            local_iterations: 1,
+            local_solver: LocalSolver::Powell,
+            settled_term: 0.0,
+        }
+    }
+
     /// Two or four coincident corners make a corner's shape 0/0: the quad's shape is still 0,
     /// wherever the NaN corner falls in the order of the corners.
     #[test]
@@ -708,6 +784,7 @@ mod tests {
             for turn in 0..4 {
                 let p: [Point; 4] = std::array::from_fn(|i| quad[(i + turn) % 4]);
                 assert_eq!(energy::shape(&p), 0.0, "{p:?}");
+                assert_eq!(energy::shapes_and_areas(&[p, p]).0, [0.0; 2], "{p:?}");
                 assert_eq!(
                     imesh_quality::quad::shape(&p.map(|p| [p.x, p.y])),
                     0.0,
@@ -761,6 +838,39 @@ mod tests {
                 prop_assert_eq!(ours.to_bits(), verdict.to_bits(), "{:?}", p);
             } else {
                 prop_assert!(ours < SURE_SHAPE, "{:?}: {}", p, ours);
+            }
+        }
+
+        /// Four quads scored side by side give each quad's metric, shape and area to the bit
+        /// as one by one, for both metrics: valid, clockwise, crossed and flat quads (a corner
+        /// on its neighbours' line), at any scale and offset.
+        #[test]
+        fn quads_side_by_side_score_as_one_by_one(
+            corners in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 16),
+            scale in 1e-3f64..1e3, offset in -1e4f64..1e4, flat in 0usize..5,
+            average_area in 1e-3f64..1e3,
+        ) {
+            let mut quads: [[Point; 4]; 4] = std::array::from_fn(|l| {
+                std::array::from_fn(|i| {
+                    let (x, y) = corners[4 * l + i];
+                    Point::new(offset + scale * x, offset / 3.0 + scale * y)
+                })
+            });
+            if flat < 4 {
+                let q = &mut quads[flat];
+                q[1] = Point::new(0.5 * (q[0].x + q[2].x), 0.5 * (q[0].y + q[2].y));
+            }
+            for metric in [Metric::ShapeAndSize, Metric::Shape] {
+                let setup = Setup { metric, average_area, ..unit_setup() };
+                let (s, shape, area) = setup.qualities_and_areas(&quads);
+                for (l, quad) in quads.iter().enumerate() {
+                    let (s1, shape1, area1) = setup.quality_and_area(quad);
+                    prop_assert_eq!(
+                        [s[l].to_bits(), shape[l].to_bits(), area[l].to_bits()],
+                        [s1.to_bits(), shape1.to_bits(), area1.to_bits()],
+                        "{:?} {:?}", quad, metric
+                    );
+                }
             }
         }
 

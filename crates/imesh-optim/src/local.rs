@@ -26,6 +26,9 @@ struct LocalEnergy<'a> {
     setup: Setup<'a>,
 }
 
+/// Quads a local energy scores side by side ([`crate::energy::shapes_and_areas`]).
+const LANES: usize = 4;
+
 /// The share of the nearest ring edge's distance within which [`LocalEnergy`] trusts a step
 /// without the exact predicates.
 const RING_MARGIN: f64 = 0.99;
@@ -72,11 +75,23 @@ impl LocalEnergy<'_> {
             return f64::INFINITY;
         }
         let mut sum = 0.0;
-        for (k, quad) in self.corners {
-            let q = quad.map(|(base, w)| moved(base, delta, w));
-            match self.setup.term(*k, &q) {
-                Some(e) => sum += e,
-                None => return f64::INFINITY,
+        // Four quads at a time (the last group padded with its last quad, whose extra
+        // results are not read), each term added in order as one by one.
+        for group in self.corners.chunks(LANES) {
+            let quads: [[Point; 4]; LANES] = std::array::from_fn(|l| {
+                group[l.min(group.len() - 1)]
+                    .1
+                    .map(|(base, w)| moved(base, delta, w))
+            });
+            let (s, shapes, areas) = self.setup.qualities_and_areas(&quads);
+            for (l, (k, _)) in group.iter().enumerate() {
+                match self
+                    .setup
+                    .term_given(*k, &quads[l], s[l], shapes[l], areas[l])
+                {
+                    Some(e) => sum += e,
+                    None => return f64::INFINITY,
+                }
             }
         }
         sum
