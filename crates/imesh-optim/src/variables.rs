@@ -5,6 +5,7 @@
 use imesh_geom::predicates::orient2d;
 use imesh_geom::{Point, Triangulation};
 use imesh_quad::{ControlNet, Element, ElementMesh, QuadMesh, Template, TRIANGLE_SLOTS};
+use rayon::prelude::*;
 
 /// Compressed rows: `items[first[i]..first[i + 1]]` belong to row `i`.
 #[derive(Clone, Debug, Default)]
@@ -32,12 +33,6 @@ impl<T> Rows<T> {
         &self.items[self.span(i)]
     }
 
-    /// Row `i`, to change in place.
-    fn row_mut(&mut self, i: usize) -> &mut [T] {
-        let span = self.span(i);
-        &mut self.items[span]
-    }
-
     /// Where row `i`'s items are in `items` (and in any list built item for item from them).
     fn span(&self, i: usize) -> std::ops::Range<usize> {
         self.first[i] as usize..self.first[i + 1] as usize
@@ -47,9 +42,68 @@ impl<T> Rows<T> {
     pub(crate) fn len(&self) -> usize {
         self.first.len().saturating_sub(1)
     }
+
+    /// Every row, to change in place (each its own slice, so that they can be changed in
+    /// parallel).
+    fn rows_mut(&mut self) -> Vec<&mut [T]> {
+        let mut rows = Vec::with_capacity(self.len());
+        let mut rest = &mut self.items[..];
+        for w in self.first.windows(2) {
+            let (row, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
+            rows.push(row);
+            rest = tail;
+        }
+        rows
+    }
 }
 
 impl<T: Copy> Rows<T> {
+    /// Rows of `lengths[r]` items each, all `fill`, to be written in place.
+    fn with_lengths(lengths: &[u32], fill: T) -> Self {
+        let mut first = Vec::with_capacity(lengths.len() + 1);
+        first.push(0);
+        let mut total = 0;
+        for &n in lengths {
+            total += n;
+            first.push(total);
+        }
+        Self {
+            first,
+            items: vec![fill; total as usize],
+        }
+    }
+
+    /// The rows `r` that `keep[r]` says yes to, each with its first `lengths[r]` items.
+    fn compacted(&self, lengths: &[u32], keep: &[bool]) -> Self {
+        let kept = || (0..self.len()).filter(|&r| keep[r]);
+        let total: usize = kept().map(|r| lengths[r] as usize).sum();
+        let mut rows = Self::with_capacity(self.len(), total);
+        for r in kept() {
+            rows.push_row(self.row(r)[..lengths[r] as usize].iter().copied());
+        }
+        rows
+    }
+
+    /// No rows yet, room for `rows` rows of `items` items in all.
+    fn with_capacity(rows: usize, items: usize) -> Self {
+        let mut first = Vec::with_capacity(rows + 1);
+        first.push(0);
+        Self {
+            first,
+            items: Vec::with_capacity(items),
+        }
+    }
+
+    /// Appends rows of `lengths` items each, taken in order from `items`.
+    fn append_rows(&mut self, lengths: &[u32], items: &[T]) {
+        self.items.extend_from_slice(items);
+        let mut total = *self.first.last().unwrap_or(&0);
+        for &n in lengths {
+            total += n;
+            self.first.push(total);
+        }
+    }
+
     /// `rows` rows from `(row, item)` pairs, each row's items in the pairs' order (a counting
     /// sort: no list per row).
     pub(crate) fn from_pairs(rows: usize, pairs: &[(u32, T)]) -> Self {
@@ -72,35 +126,15 @@ impl<T: Copy> Rows<T> {
         }
         Self { first, items }
     }
+}
 
-    /// Keeps, in every row, the items `keep` says yes to (given the row and the item's place
-    /// in it).
-    fn retain(&mut self, mut keep: impl FnMut(&[T], usize) -> bool) {
-        let mut items = Vec::with_capacity(self.items.len());
-        let mut first = Vec::with_capacity(self.first.len());
-        first.push(0);
-        for r in 0..self.len() {
-            let row = self.row(r);
-            for k in 0..row.len() {
-                if keep(row, k) {
-                    items.push(row[k]);
-                }
-            }
-            first.push(items.len() as u32);
-        }
-        *self = Self { first, items };
-    }
-
-    /// Keeps the rows `keep` says yes to.
-    fn keep_rows(&self, keep: &[bool]) -> Self {
-        let mut rows = Self::new();
-        for (r, &k) in keep.iter().enumerate() {
-            if k {
-                rows.push_row(self.row(r).iter().copied());
-            }
-        }
-        rows
-    }
+/// The quad rows and corner weights of a run of variables, as [`Variables::finish`] builds
+/// them a chunk at a time.
+#[derive(Default)]
+struct QuadRows {
+    lengths: Vec<u32>,
+    quads: Vec<u32>,
+    weights: Vec<[f64; 4]>,
 }
 
 /// The movable points of one optimisation.
@@ -238,61 +272,88 @@ impl Variables {
                 })
                 .collect()
         });
+        // Each free control point becomes a variable where it is first met (element by
+        // element, slot by slot), and its rows list what each patch holding it gives, in that
+        // order: counted in a first pass, written in place in a second.
+        let kind_of = |k: usize| usize::from(matches!(m.elements[k], Element::Quad(_)));
+        let slots = |kind: usize| if kind == 1 { 16 } else { 10 };
         let mut variable_of = vec![u32::MAX; net.points.len()];
         let mut ids = Vec::new();
-        let mut influence: Vec<(u32, (u32, f64))> = Vec::new();
-        let mut ring: Vec<(u32, [u32; 2])> = Vec::new();
-        for (k, element) in m.elements.iter().enumerate() {
-            let kind = usize::from(matches!(element, Element::Quad(_)));
-            let slots = if kind == 1 { 16 } else { 10 };
-            let patch = &net.patches[k];
-            let vertices = mesh.element_vertices(k);
-            for s in 0..slots {
-                let c = patch[s];
+        let (mut influence_len, mut ring_len) = (Vec::new(), Vec::new());
+        for (k, patch) in net.patches.iter().enumerate().take(m.elements.len()) {
+            let kind = kind_of(k);
+            for (s, &c) in patch[..slots(kind)].iter().enumerate() {
                 if fixed[c as usize] {
                     continue;
                 }
                 if variable_of[c as usize] == u32::MAX {
                     variable_of[c as usize] = ids.len() as u32;
                     ids.push(c);
+                    influence_len.push(0);
+                    ring_len.push(0);
                 }
-                let i = variable_of[c as usize];
-                influence.extend(
-                    by_slot[kind][s]
-                        .iter()
-                        .map(|&(point, w)| (i, (vertices[point], w))),
-                );
-                ring.extend(
-                    ring_of[kind][s]
-                        .iter()
-                        .map(|&[a, b]| (i, [patch[a], patch[b]])),
-                );
+                let i = variable_of[c as usize] as usize;
+                influence_len[i] += by_slot[kind][s].len() as u32;
+                ring_len[i] += ring_of[kind][s].len() as u32;
             }
         }
-        let mut influence = Rows::from_pairs(ids.len(), &influence);
-        let ring = Rows::from_pairs(ids.len(), &ring);
-        // A vertex on a side shared by two patches appears in both, with the same weight: the
-        // first is kept, and the rows sorted by vertex.
-        for r in 0..influence.len() {
-            influence.row_mut(r).sort_by_key(|&(v, _)| v);
+        let mut influence = Rows::with_lengths(&influence_len, (0, 0.0));
+        let mut ring = Rows::with_lengths(&ring_len, [0, 0]);
+        let mut next_influence = influence.first.clone();
+        let mut next_ring = ring.first.clone();
+        for (k, patch) in net.patches.iter().enumerate().take(m.elements.len()) {
+            let kind = kind_of(k);
+            let vertices = mesh.element_vertices(k);
+            for (s, &c) in patch[..slots(kind)].iter().enumerate() {
+                let i = variable_of[c as usize] as usize;
+                if i == u32::MAX as usize {
+                    continue; // fixed
+                }
+                for &(point, w) in &by_slot[kind][s] {
+                    influence.items[next_influence[i] as usize] = (vertices[point], w);
+                    next_influence[i] += 1;
+                }
+                for &[a, b] in &ring_of[kind][s] {
+                    ring.items[next_ring[i] as usize] = [patch[a], patch[b]];
+                    next_ring[i] += 1;
+                }
+            }
         }
-        influence.retain(|row, k| k == 0 || row[k].0 != row[k - 1].0);
+        // A vertex on a side shared by two patches appears in both, with the same weight: the
+        // first is kept, and the rows sorted by vertex (stably: the first stays first).
+        let kept: Vec<u32> = influence
+            .rows_mut()
+            .into_par_iter()
+            .map(|row| {
+                row.sort_by_key(|&(v, _)| v);
+                let mut n = 0;
+                for j in 0..row.len() {
+                    if n == 0 || row[j].0 != row[n - 1].0 {
+                        row[n] = row[j];
+                        n += 1;
+                    }
+                }
+                n as u32
+            })
+            .collect();
         // Control points that move exactly the same quad vertices are one degree of freedom
         // solved several times: at level 1 a quad patch's four inner points all move only its
         // centre, and an edge's two inner points the same midpoint and centres. The first of
         // each such set is kept.
-        let keys: Vec<u32> = influence.items.iter().map(|&(v, _)| v).collect();
-        let mut seen = std::collections::HashSet::new();
-        let keep: Vec<bool> = (0..influence.len())
-            .map(|r| seen.insert(&keys[influence.span(r)]))
-            .collect();
+        let keep = first_of_equal_rows(&influence, &kept);
         let ids = ids
             .into_iter()
             .zip(&keep)
             .filter(|&(_, &k)| k)
             .map(|(x, _)| x)
             .collect();
-        Self::finish(ids, influence.keep_rows(&keep), ring.keep_rows(&keep), mesh)
+        let ring_len: Vec<u32> = (0..ring.len()).map(|r| ring.row(r).len() as u32).collect();
+        Self::finish(
+            ids,
+            influence.compacted(&kept, &keep),
+            ring.compacted(&ring_len, &keep),
+            mesh,
+        )
     }
 
     /// The free quad vertices: all but those on constrained M edges (vertex mode).
@@ -327,41 +388,49 @@ impl Variables {
         mesh: &QuadMesh,
     ) -> Self {
         let around = vertex_quads(mesh);
-        // The quads around a variable's vertices, each once (a stamp per quad), sorted.
-        let mut stamp = vec![u32::MAX; mesh.quads.len()];
-        let mut quads = Rows::new();
-        let mut row = Vec::new();
-        for i in 0..influence.len() {
-            row.clear();
-            for &(v, _) in influence.row(i) {
-                for &q in around.row(v as usize) {
-                    if stamp[q as usize] != i as u32 {
-                        stamp[q as usize] = i as u32;
-                        row.push(q);
+        // Per variable, the quads around its vertices (each once, sorted) and its weight in each
+        // of their corners (0 for a corner it does not move); a chunk of variables per task,
+        // the chunks' rows then laid end to end.
+        const CHUNK: usize = 1024;
+        let chunks: Vec<QuadRows> = (0..influence.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut chunk = QuadRows::default();
+                let (mut row_quads, mut weights) = (Vec::new(), Vec::new());
+                for i in c * CHUNK..((c + 1) * CHUNK).min(influence.len()) {
+                    let row = influence.row(i);
+                    row_quads.clear();
+                    for &(v, _) in row {
+                        row_quads.extend_from_slice(around.row(v as usize));
                     }
-                }
-            }
-            row.sort_unstable();
-            quads.push_row(row.iter().copied());
-        }
-        // Each quad corner's weight, found in the variable's short influence row.
-        let mut items: Vec<[f64; 4]> = Vec::with_capacity(quads.items.len());
-        for i in 0..influence.len() {
-            let row = influence.row(i);
-            for &q in quads.row(i) {
-                let mut w = [0.0; 4];
-                for (k, &v) in mesh.quads[q as usize].iter().enumerate() {
-                    if let Some(&(_, x)) = row.iter().find(|&&(u, _)| u == v) {
-                        w[k] = x;
+                    row_quads.sort_unstable();
+                    row_quads.dedup();
+                    weights.clear();
+                    weights.resize(row_quads.len(), [0.0; 4]);
+                    for &(v, w) in row {
+                        for &q in around.row(v as usize) {
+                            let corner = mesh.quads[q as usize].iter().position(|&u| u == v);
+                            if let (Ok(at), Some(corner)) = (row_quads.binary_search(&q), corner) {
+                                weights[at][corner] = w;
+                            }
+                        }
                     }
+                    chunk.lengths.push(row_quads.len() as u32);
+                    chunk.quads.extend_from_slice(&row_quads);
+                    chunk.weights.extend_from_slice(&weights);
                 }
-                items.push(w);
-            }
+                chunk
+            })
+            .collect();
+        let (rows, total) = chunks
+            .iter()
+            .fold((0, 0), |(r, n), c| (r + c.lengths.len(), n + c.quads.len()));
+        let mut quads = Rows::with_capacity(rows, total);
+        let mut corner_weights = Rows::with_capacity(rows, total);
+        for chunk in chunks {
+            quads.append_rows(&chunk.lengths, &chunk.quads);
+            corner_weights.append_rows(&chunk.lengths, &chunk.weights);
         }
-        let corner_weights = Rows {
-            first: quads.first.clone(),
-            items,
-        };
         let by_quad = by_quad(&quads, mesh.quads.len());
         let colours = colour(&quads, &by_quad);
         Self {
@@ -388,6 +457,39 @@ impl Variables {
             .iter()
             .all(|&[a, b]| orient2d(net[a as usize], net[b as usize], p) > 0.0)
     }
+}
+
+/// Per row of `influence` (its first `lengths[r]` items), whether no earlier row moves the
+/// same vertices (the same vertex keys in the same order). Equal rows start with the same vertex: rows are compared only with
+/// the earlier rows starting with theirs (empty rows with one another).
+fn first_of_equal_rows(influence: &Rows<(u32, f64)>, lengths: &[u32]) -> Vec<bool> {
+    let row = |r: usize| &influence.row(r)[..lengths[r] as usize];
+    let start = |r: usize| row(r).first().map_or(u32::MAX, |&(v, _)| v);
+    let mut order: Vec<u64> = (0..influence.len())
+        .map(|r| (u64::from(start(r)) << 32) | r as u64)
+        .collect();
+    order.par_sort_unstable();
+    let same = |a: usize, b: usize| {
+        let (x, y) = (row(a), row(b));
+        x.len() == y.len() && x.iter().zip(y).all(|(p, q)| p.0 == q.0)
+    };
+    let mut keep = vec![true; influence.len()];
+    let mut group = 0;
+    while group < order.len() {
+        let key = order[group] >> 32;
+        let end = (group..order.len())
+            .find(|&j| order[j] >> 32 != key)
+            .unwrap_or(order.len());
+        for j in group + 1..end {
+            let r = order[j] as u32 as usize;
+            keep[r] = !(group..j).any(|e| {
+                let earlier = order[e] as u32 as usize;
+                keep[earlier] && same(earlier, r)
+            });
+        }
+        group = end;
+    }
+    keep
 }
 
 /// Per quad (of `n_quads`), the items whose quad lists (`quads`) hold it.
@@ -430,36 +532,78 @@ pub(crate) fn colour(quads: &Rows<u32>, by_quad: &Rows<u32>) -> Vec<Vec<u32>> {
 
 #[cfg(test)]
 mod tests {
-    use super::Rows;
+    use super::{first_of_equal_rows, Rows};
     use proptest::prelude::*;
 
     proptest! {
-        /// Rows from pairs hold, row by row, exactly the pairs' items in the pairs' order, as
-        /// lists built by pushing would; retaining and keeping rows agree with filtering those.
+        /// A row is kept unless an earlier row moves the same vertices in the same order (its
+        /// weights aside), as a set of the rows seen so far says; empty rows included.
         #[test]
-        fn rows_from_pairs_match_lists(
+        fn the_first_of_equal_rows_is_kept(
+            rows in proptest::collection::vec(proptest::collection::vec((0u32..3, 0u8..2), 0..3), 0..40),
+            cut in proptest::collection::vec(0u32..2, 40),
+        ) {
+            let mut influence = Rows::new();
+            for row in &rows {
+                influence.push_row(row.iter().map(|&(v, w)| (v, f64::from(w))));
+            }
+            let lengths: Vec<u32> =
+                rows.iter().zip(&cut).map(|(r, &c)| (r.len() as u32).saturating_sub(c)).collect();
+            let mut seen = std::collections::HashSet::new();
+            let expected: Vec<bool> = rows
+                .iter()
+                .zip(&lengths)
+                .map(|(r, &n)| seen.insert(r[..n as usize].iter().map(|&(v, _)| v).collect::<Vec<_>>()))
+                .collect();
+            prop_assert_eq!(first_of_equal_rows(&influence, &lengths), expected);
+        }
+
+        /// Rows from pairs hold, row by row, exactly the pairs' items in the pairs' order, as
+        /// lists built by pushing would; rows written in place, cut short, compacted and
+        /// appended agree with doing the same to those lists.
+        #[test]
+        fn rows_match_lists(
             pairs in proptest::collection::vec((0u32..7, any::<u16>()), 0..60),
             keep in proptest::collection::vec(any::<bool>(), 7),
+            cut in proptest::collection::vec(0u32..4, 7),
         ) {
             let mut lists = vec![Vec::new(); 7];
             for &(r, x) in &pairs {
                 lists[r as usize].push(x);
             }
-            let mut rows = Rows::from_pairs(7, &pairs);
+            let rows = Rows::from_pairs(7, &pairs);
             prop_assert_eq!(rows.len(), 7);
             for (r, list) in lists.iter().enumerate() {
                 prop_assert_eq!(rows.row(r), &list[..]);
             }
-            let kept = rows.keep_rows(&keep);
-            let expected: Vec<&Vec<u16>> = lists.iter().zip(&keep).filter(|(_, &k)| k).map(|(l, _)| l).collect();
+            // The same rows written in place, through `rows_mut`, each reversed there.
+            let lengths: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();
+            let mut written = Rows::with_lengths(&lengths, 0u16);
+            for (row, list) in written.rows_mut().into_iter().zip(&lists) {
+                row.copy_from_slice(list);
+                row.reverse();
+            }
+            let short: Vec<u32> = lengths.iter().zip(&cut).map(|(&n, &c)| n.saturating_sub(c)).collect();
+            let kept = written.compacted(&short, &keep);
+            let expected: Vec<Vec<u16>> = lists
+                .iter()
+                .zip(&short)
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|((l, &n), _)| l.iter().rev().take(n as usize).copied().collect())
+                .collect();
             prop_assert_eq!(kept.len(), expected.len());
             for (r, list) in expected.iter().enumerate() {
                 prop_assert_eq!(kept.row(r), &list[..]);
             }
-            rows.retain(|row, k| row[k] % 2 == 0);
+            // Appended in two batches, the rows are the lists again.
+            let mut appended = Rows::with_capacity(7, pairs.len());
+            for batch in [0..3, 3..7] {
+                let items: Vec<u16> = lists[batch.clone()].concat();
+                appended.append_rows(&lengths[batch], &items);
+            }
             for (r, list) in lists.iter().enumerate() {
-                let even: Vec<u16> = list.iter().copied().filter(|x| x % 2 == 0).collect();
-                prop_assert_eq!(rows.row(r), &even[..]);
+                prop_assert_eq!(appended.row(r), &list[..]);
             }
         }
     }
