@@ -335,8 +335,7 @@ impl Setup<'_> {
     /// below a floor.
     #[inline]
     pub fn term(&self, quad: usize, p: &[Point; 4]) -> Option<f64> {
-        self.feasible_quality(quad, p)
-            .map(|(s, _)| (1.0 - s) * (1.0 - s))
+        self.term_given(quad, p, self.quality_and_area(p))
     }
 
     /// [`Setup::quality_and_area`] of `N` quads at once (the same bits as one by one), lane by
@@ -366,36 +365,26 @@ impl Setup<'_> {
     }
 
     /// [`Setup::term`] of quad `p` whose metric, [`energy::shape`] and [`energy::area`] are
-    /// known.
+    /// known (`scores`, as [`Setup::quality_and_area`] gives them).
     #[inline]
-    pub fn term_given(
-        &self,
-        quad: usize,
-        p: &[Point; 4],
-        s: f64,
-        shape: f64,
-        area: f64,
-    ) -> Option<f64> {
-        self.feasible_given(quad, p, s, shape, area)
+    pub fn term_given(&self, quad: usize, p: &[Point; 4], scores: (f64, f64, f64)) -> Option<f64> {
+        self.feasible_given(quad, p, scores)
             .map(|(s, _)| (1.0 - s) * (1.0 - s))
     }
 
     /// The metric and the shape of quad `p` when it is valid and above both floors.
     #[inline]
     fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
-        let (s, shape, area) = self.quality_and_area(p);
-        self.feasible_given(quad, p, s, shape, area)
+        self.feasible_given(quad, p, self.quality_and_area(p))
     }
 
-    /// [`Setup::feasible_quality`] given the quad's metric, shape and area.
+    /// [`Setup::feasible_quality`] given the quad's metric, shape and area (`scores`).
     #[inline]
     fn feasible_given(
         &self,
         quad: usize,
         p: &[Point; 4],
-        s: f64,
-        shape: f64,
-        area: f64,
+        (s, shape, area): (f64, f64, f64),
     ) -> Option<(f64, f64)> {
         if !((shape >= SURE_SHAPE && area > 0.0) || is_valid(p)) {
             return None;
@@ -697,19 +686,10 @@ mod tests {
 
     /// The analytic gradient of a term against central differences.
     fn check_gradient(metric: Metric, p: [Point; 4]) -> Result<(), TestCaseError> {
-        let quads = [[0, 1, 2, 3]];
         let setup = Setup {
-            quads: &quads,
             metric,
             average_area: 1.3,
-            quality_floors: &[0.0],
-            shape_floors: &[0.0],
-            jacobian_floors: &[f64::NEG_INFINITY],
-            max_sweeps: 1,
-            tolerance: 0.0,
-            local_iterations: 1,
-            local_solver: LocalSolver::Powell,
-            settled_term: 0.0,
+            ..unit_setup()
         };
         let Some((_, gradient)) = setup.term_gradient(0, &p) else {
             return Ok(());

@@ -87,7 +87,7 @@ impl LocalEnergy<'_> {
             for (l, (k, _)) in group.iter().enumerate() {
                 match self
                     .setup
-                    .term_given(*k, &quads[l], s[l], shapes[l], areas[l])
+                    .term_given(*k, &quads[l], (s[l], shapes[l], areas[l]))
                 {
                     Some(e) => sum += e,
                     None => return f64::INFINITY,
