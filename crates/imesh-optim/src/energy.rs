@@ -52,28 +52,16 @@ pub(crate) fn area(p: &[Point; 4]) -> f64 {
 /// [`imesh_quality::quad::shape`], so the same bits, without the tests only a degenerate or
 /// clockwise quad needs (an edge under 10⁻⁷ of the quad's size, where this gives a shape under
 /// 10⁻⁷ and Verdict 0; a clockwise quad, which this scores 0 and Verdict by its mirror image:
-/// the optimiser rejects both).
+/// the optimiser rejects both). Computed as [`shapes_and_areas`] of the one quad.
 #[inline]
 pub(crate) fn shape(p: &[Point; 4]) -> f64 {
-    let e = [p[1] - p[0], p[2] - p[1], p[3] - p[2], p[0] - p[3]];
-    let len2 = e.map(|v| v.x * v.x + v.y * v.y);
-    let cross = |a: Point, b: Point| a.x * b.y - a.y * b.x;
-    let mut worst = cross(e[3], e[0]) / (len2[0] + len2[3]);
-    worst = least(worst, cross(e[0], e[1]) / (len2[1] + len2[0]));
-    worst = least(worst, cross(e[1], e[2]) / (len2[2] + len2[1]));
-    worst = least(worst, cross(e[2], e[3]) / (len2[3] + len2[2]));
-    let q = 2.0 * worst;
-    // Verdict's floor (its DBL_MIN); false for NaN (a quad with two zero edges) too.
-    if q >= 2.220_446_049_250_313e-15 {
-        q
-    } else {
-        0.0
-    }
+    shapes_and_areas(&[*p]).0[0]
 }
 
-/// [`shape`] and [`area`] of `N` quads at once, lane by lane with the same operations in the
-/// same order (so the same bits), written over arrays of `N` so that the compiler can put the
-/// lanes side by side in vector registers: a local solve scores several quads per trial point.
+/// [`shape`] and [`area`] of `N` quads at once, each lane with the same operations in the same
+/// order whatever `N` (so the same bits as one by one), written over arrays of `N` so that the
+/// compiler puts the lanes side by side in vector registers (its divisions become `divpd`): a
+/// local solve scores several quads per trial point.
 #[inline]
 pub(crate) fn shapes_and_areas<const N: usize>(p: &[[Point; 4]; N]) -> ([f64; N], [f64; N]) {
     // The corners' coordinates lane by lane.
@@ -101,14 +89,13 @@ pub(crate) fn shapes_and_areas<const N: usize>(p: &[[Point; 4]; N]) -> ([f64; N]
         worst = least(worst, cross(e1, e2) / (l2 + l1));
         worst = least(worst, cross(e2, e3) / (l3 + l2));
         let q = 2.0 * worst;
+        // Verdict's floor (its DBL_MIN); false for NaN (a quad with two zero edges) too.
         shape[l] = if q >= 2.220_446_049_250_313e-15 {
             q
         } else {
             0.0
         };
-        area[l] = 0.5
-            * ((px[2][l] - px[0][l]) * (py[3][l] - py[1][l])
-                - (px[3][l] - px[1][l]) * (py[2][l] - py[0][l]));
+        area[l] = self::area(&p[l]);
     }
     (shape, area)
 }
