@@ -47,18 +47,12 @@ pub(crate) fn area(p: &[Point; 4]) -> f64 {
     0.5 * ((p[2].x - p[0].x) * (p[3].y - p[1].y) - (p[3].x - p[1].x) * (p[2].y - p[0].y))
 }
 
-/// Verdict's shape of the quad `p`, as the optimiser computes it millions of times: for a
-/// counter-clockwise quad the same operations in the same order as
-/// [`imesh_quality::quad::shape`], so the same bits, without the tests only a degenerate or
-/// clockwise quad needs (an edge under 10⁻⁷ of the quad's size, where this gives a shape under
-/// 10⁻⁷ and Verdict 0; a clockwise quad, which this scores 0 and Verdict by its mirror image:
-/// the optimiser rejects both). Computed as [`shapes_and_areas`] of the one quad.
-#[inline]
-pub(crate) fn shape(p: &[Point; 4]) -> f64 {
-    shapes_and_areas(&[*p]).0[0]
-}
-
-/// [`shape`] and [`area`] of `N` quads at once, each lane with the same operations in the same
+/// Verdict's shape and the signed [`area`] of `N` quads at once, as the optimiser computes them
+/// millions of times. The shape: for a counter-clockwise quad the same operations in the same
+/// order as [`imesh_quality::quad::shape`], so the same bits, without the tests only a
+/// degenerate or clockwise quad needs (an edge under 10⁻⁷ of the quad's size, where this gives
+/// a shape under 10⁻⁷ and Verdict 0; a clockwise quad, which this scores 0 and Verdict by its
+/// mirror image: the optimiser rejects both). Each lane has the same operations in the same
 /// order whatever `N` (so the same bits as one by one), written over arrays of `N` so that the
 /// compiler puts the lanes side by side in vector registers (its divisions become `divpd`): a
 /// local solve scores several quads per trial point.
@@ -172,7 +166,7 @@ pub(crate) fn jacobian_under(p: &[Point; 4], cap: f64) -> f64 {
 
 /// The lesser of `a` and `b`, without `f64::min`'s care for NaN (its NaN test cost 6 % of the
 /// optimiser's time). A corner is NaN only between two zero edges, which give the next corner
-/// a zero cross product: the least of the four is then NaN or at most 0, and [`shape`]'s floor
+/// a zero cross product: the least of the four is then NaN or at most 0, and the shape's floor
 /// turns either into 0, as Verdict does.
 #[inline]
 fn least(a: f64, b: f64) -> f64 {

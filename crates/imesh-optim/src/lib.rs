@@ -310,25 +310,12 @@ impl Setup<'_> {
         (s, shape)
     }
 
-    /// [`Setup::quality`] and the quad's signed area.
+    /// [`Setup::quality`] and the quad's signed area ([`Setup::qualities_and_areas`] of the one
+    /// quad).
     #[inline]
     fn quality_and_area(&self, p: &[Point; 4]) -> (f64, f64, f64) {
-        let shape = energy::shape(p);
-        let area = energy::area(p);
-        (self.metric_of(shape, area), shape, area)
-    }
-
-    /// The metric of a quad of shape `shape` and signed area `area`.
-    #[inline]
-    fn metric_of(&self, shape: f64, area: f64) -> f64 {
-        match self.metric {
-            Metric::Shape => shape,
-            Metric::ShapeAndSize => {
-                let r = area / self.average_area;
-                let m = if r > 0.0 { r.min(1.0 / r) } else { 0.0 };
-                shape * m * m
-            }
-        }
+        let (s, shape, area) = self.qualities_and_areas(&[*p]);
+        (s[0], shape[0], area[0])
     }
 
     /// The energy term `(1 − s)²` of quad `p`, or `None` when the quad is invalid or falls
@@ -349,8 +336,9 @@ impl Setup<'_> {
         let s = match self.metric {
             Metric::Shape => shape,
             Metric::ShapeAndSize => {
-                // `metric_of`'s steps without its branch: the relative size of a quad of no
-                // positive area is computed and then dropped for 0.
+                // Shape times the relative size `min(R, 1/R)²`, `R = area / Ā`, without a
+                // branch: the relative size of a quad of no positive area is computed, then
+                // dropped for 0.
                 let mut s = [0.0; N];
                 for l in 0..N {
                     let r = area[l] / self.average_area;
@@ -364,7 +352,7 @@ impl Setup<'_> {
         (s, shape, area)
     }
 
-    /// [`Setup::term`] of quad `p` whose metric, [`energy::shape`] and [`energy::area`] are
+    /// [`Setup::term`] of quad `p` whose metric, shape and area ([`energy::shapes_and_areas`]) are
     /// known (`scores`, as [`Setup::quality_and_area`] gives them).
     #[inline]
     pub fn term_given(&self, quad: usize, p: &[Point; 4], scores: (f64, f64, f64)) -> Option<f64> {
@@ -728,6 +716,11 @@ mod tests {
         Ok(())
     }
 
+    /// The optimiser's shape of the one quad `p`.
+    fn shape_of(p: &[Point; 4]) -> f64 {
+        energy::shapes_and_areas(&[*p]).0[0]
+    }
+
     /// A setup of one quad with no floors.
     fn unit_setup() -> Setup<'static> {
         Setup {
@@ -763,7 +756,7 @@ mod tests {
         ] {
             for turn in 0..4 {
                 let p: [Point; 4] = std::array::from_fn(|i| quad[(i + turn) % 4]);
-                assert_eq!(energy::shape(&p), 0.0, "{p:?}");
+                assert_eq!(shape_of(&p), 0.0, "{p:?}");
                 assert_eq!(energy::shapes_and_areas(&[p, p]).0, [0.0; 2], "{p:?}");
                 assert_eq!(
                     imesh_quality::quad::shape(&p.map(|p| [p.x, p.y])),
@@ -795,7 +788,7 @@ mod tests {
             // Corner `flat` on the line of its neighbours, nudged across by `hair` of the scale.
             let (a, b) = (p[(flat + 3) % 4], p[(flat + 1) % 4]);
             p[flat] = Point::new(0.5 * (a.x + b.x) - hair * scale * (b.y - a.y), 0.5 * (a.y + b.y) + hair * scale * (b.x - a.x));
-            let shape = energy::shape(&p);
+            let shape = shape_of(&p);
             if shape >= SURE_SHAPE && energy::area(&p) > 0.0 {
                 prop_assert!(is_valid(&p), "{p:?}: shape {shape}");
             }
@@ -813,7 +806,7 @@ mod tests {
                 Point::new(offset + scale * corners[i].0, offset / 3.0 + scale * corners[i].1)
             });
             let verdict = imesh_quality::quad::shape(&p.map(|p| [p.x, p.y]));
-            let ours = energy::shape(&p);
+            let ours = shape_of(&p);
             if is_valid(&p) {
                 prop_assert_eq!(ours.to_bits(), verdict.to_bits(), "{:?}", p);
             } else {
