@@ -368,7 +368,7 @@ impl Setup<'_> {
 
     /// [`Setup::feasible_quality`] given the quad's metric, shape and area (`scores`).
     #[inline]
-    fn feasible_given(
+    pub(crate) fn feasible_given(
         &self,
         quad: usize,
         p: &[Point; 4],
