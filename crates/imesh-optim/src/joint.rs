@@ -245,25 +245,21 @@ fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
 /// it; the sum spreads the gain over many quads instead of raising the worst.
 fn shortfall(quads: &[u32], points: &[Point], setup: &Setup, bar: f64) -> f64 {
     let (mut jacobian, mut shape) = (0.0, 0.0);
-    // Four quads at a time, side by side (the last group padded with its last quad).
-    for group in quads.chunks(4) {
-        let corners: [[Point; 4]; 4] = std::array::from_fn(|l| {
-            setup.quads[group[l.min(group.len() - 1)] as usize].map(|u| points[u as usize])
-        });
-        let (metric, shapes, areas) = setup.qualities_and_areas(&corners);
-        for (l, &q) in group.iter().enumerate() {
-            let p = &corners[l];
-            let Some((_, s)) =
-                setup.feasible_given(q as usize, p, (metric[l], shapes[l], areas[l]))
-            else {
-                return f64::INFINITY;
-            };
-            if s < bar {
-                let j = crate::energy::jacobian_under(p, bar);
-                shape += (bar - s) * (bar - s);
-                jacobian += (bar - j).max(0.0).powi(2);
-            }
+    let mut feasible = true;
+    setup.visit_feasible(quads, points, |p, quality| {
+        let Some((_, s)) = quality else {
+            feasible = false;
+            return false;
+        };
+        if s < bar {
+            let j = crate::energy::jacobian_under(p, bar);
+            shape += (bar - s) * (bar - s);
+            jacobian += (bar - j).max(0.0).powi(2);
         }
+        true
+    });
+    if !feasible {
+        return f64::INFINITY;
     }
     jacobian.sqrt() + shape.sqrt()
 }

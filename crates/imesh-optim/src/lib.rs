@@ -360,6 +360,35 @@ impl Setup<'_> {
             .map(|(s, _)| (1.0 - s) * (1.0 - s))
     }
 
+    /// Visits `quads` (over `vertices`) in order, each with its corners and, when it is valid
+    /// and above its floors, its metric and shape ([`Setup::feasible_quality`]); the quads
+    /// scored four at a time, side by side ([`Setup::qualities_and_areas`]). Stops when `visit`
+    /// returns false.
+    #[inline]
+    pub(crate) fn visit_feasible(
+        &self,
+        quads: &[u32],
+        vertices: &[Point],
+        mut visit: impl FnMut(&[Point; 4], Option<(f64, f64)>) -> bool,
+    ) {
+        for group in quads.chunks(4) {
+            // The last group padded with its last quad, whose results are not read.
+            let corners: [[Point; 4]; 4] = std::array::from_fn(|l| {
+                self.quads[group[l.min(group.len() - 1)] as usize].map(|u| vertices[u as usize])
+            });
+            let (metric, shape, area) = self.qualities_and_areas(&corners);
+            for (l, &q) in group.iter().enumerate() {
+                let scores = (metric[l], shape[l], area[l]);
+                if !visit(
+                    &corners[l],
+                    self.feasible_given(q as usize, &corners[l], scores),
+                ) {
+                    return;
+                }
+            }
+        }
+    }
+
     /// The metric and the shape of quad `p` when it is valid and above both floors.
     #[inline]
     fn feasible_quality(&self, quad: usize, p: &[Point; 4]) -> Option<(f64, f64)> {
@@ -368,7 +397,7 @@ impl Setup<'_> {
 
     /// [`Setup::feasible_quality`] given the quad's metric, shape and area (`scores`).
     #[inline]
-    pub(crate) fn feasible_given(
+    fn feasible_given(
         &self,
         quad: usize,
         p: &[Point; 4],

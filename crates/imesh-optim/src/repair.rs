@@ -310,17 +310,21 @@ pub(crate) fn corners_value(
     bar: f64,
 ) -> Option<(f64, f64)> {
     let (mut jacobian, mut shape) = (bar, bar);
-    for &q in quads {
-        let p = setup.quads[q as usize].map(|u| vertices[u as usize]);
-        let (_, s) = setup.feasible_quality(q as usize, &p)?;
+    let mut feasible = true;
+    setup.visit_feasible(quads, vertices, |p, quality| {
+        let Some((_, s)) = quality else {
+            feasible = false;
+            return false;
+        };
         shape = shape.min(s);
         // The scaled Jacobian is at least the shape: only a shape under the bar can leave it
         // there.
         if s < bar {
-            jacobian = jacobian.min(crate::energy::jacobian_under(&p, jacobian));
+            jacobian = jacobian.min(crate::energy::jacobian_under(p, jacobian));
         }
-    }
-    Some((jacobian, shape))
+        true
+    });
+    feasible.then_some((jacobian, shape))
 }
 
 /// The 3 × 3 grid of points (row by row) of the repairs' tests: with every point pinned but the
