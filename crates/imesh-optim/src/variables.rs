@@ -60,17 +60,10 @@ impl<T> Rows<T> {
 impl<T: Copy> Rows<T> {
     /// Rows of `lengths[r]` items each, all `fill`, to be written in place.
     fn with_lengths(lengths: &[u32], fill: T) -> Self {
-        let mut first = Vec::with_capacity(lengths.len() + 1);
-        first.push(0);
-        let mut total = 0;
-        for &n in lengths {
-            total += n;
-            first.push(total);
-        }
-        Self {
-            first,
-            items: vec![fill; total as usize],
-        }
+        let mut rows = Self::with_capacity(lengths.len(), 0);
+        rows.push_lengths(lengths);
+        rows.items = vec![fill; *rows.first.last().unwrap_or(&0) as usize];
+        rows
     }
 
     /// The rows `r` that `keep[r]` says yes to, each with its first `lengths[r]` items.
@@ -97,6 +90,11 @@ impl<T: Copy> Rows<T> {
     /// Appends rows of `lengths` items each, taken in order from `items`.
     fn append_rows(&mut self, lengths: &[u32], items: &[T]) {
         self.items.extend_from_slice(items);
+        self.push_lengths(lengths);
+    }
+
+    /// Ends of rows of `lengths` items each after the last row.
+    fn push_lengths(&mut self, lengths: &[u32]) {
         let mut total = *self.first.last().unwrap_or(&0);
         for &n in lengths {
             total += n;
@@ -347,7 +345,6 @@ impl Variables {
             .filter(|&(_, &k)| k)
             .map(|(x, _)| x)
             .collect();
-        let ring_len: Vec<u32> = (0..ring.len()).map(|r| ring.row(r).len() as u32).collect();
         Self::finish(
             ids,
             influence.compacted(&kept, &keep),
