@@ -277,6 +277,11 @@ pub(crate) struct Setup<'a> {
     pub settled_term: f64,
 }
 
+/// Quads scored side by side ([`Setup::qualities_and_areas`]) by the local solves and the
+/// repairs: four lanes fill two vector registers of the baseline x86-64 (SSE2), and a local
+/// solve's point most often moves four quads (a quad patch's centre).
+pub(crate) const LANES: usize = 4;
+
 /// A quad whose shape (as computed) is at least this, with a positive area, is valid without
 /// the exact test. Every corner's cross product `α = a × b` is then at least `shape · |a| |b|
 /// ≥ shape · (|aₓ b_y| + |a_y bₓ|)`, some 10⁵ times the bound on its rounding error (about
@@ -362,8 +367,8 @@ impl Setup<'_> {
 
     /// Visits `quads` (over `vertices`) in order, each with its corners and, when it is valid
     /// and above its floors, its metric and shape ([`Setup::feasible_quality`]); the quads
-    /// scored four at a time, side by side ([`Setup::qualities_and_areas`]). Stops when `visit`
-    /// returns false.
+    /// scored [`LANES`] at a time, side by side ([`Setup::qualities_and_areas`]). Stops when
+    /// `visit` returns false.
     #[inline]
     pub(crate) fn visit_feasible(
         &self,
@@ -371,9 +376,9 @@ impl Setup<'_> {
         vertices: &[Point],
         mut visit: impl FnMut(&[Point; 4], Option<(f64, f64)>) -> bool,
     ) {
-        for group in quads.chunks(4) {
+        for group in quads.chunks(LANES) {
             // The last group padded with its last quad, whose results are not read.
-            let corners: [[Point; 4]; 4] = std::array::from_fn(|l| {
+            let corners: [[Point; 4]; LANES] = std::array::from_fn(|l| {
                 self.quads[group[l.min(group.len() - 1)] as usize].map(|u| vertices[u as usize])
             });
             let (metric, shape, area) = self.qualities_and_areas(&corners);

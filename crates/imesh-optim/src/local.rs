@@ -11,7 +11,7 @@ use imesh_geom::Point;
 use rayon::prelude::*;
 
 use crate::variables::Variables;
-use crate::{LocalSolver, Powell, Setup};
+use crate::{LocalSolver, Powell, Setup, LANES};
 
 /// What one local solve sees: the corners of the quads it changes as `base + weight · δ`, and
 /// the neighbour-polygon edges its point must stay left of.
@@ -25,9 +25,6 @@ struct LocalEnergy<'a> {
     origin: Point,
     setup: Setup<'a>,
 }
-
-/// Quads a local energy scores side by side ([`crate::energy::shapes_and_areas`]).
-const LANES: usize = 4;
 
 /// The share of the nearest ring edge's distance within which [`LocalEnergy`] trusts a step
 /// without the exact predicates.
@@ -75,8 +72,11 @@ impl LocalEnergy<'_> {
             return f64::INFINITY;
         }
         let mut sum = 0.0;
-        // Four quads at a time (the last group padded with its last quad, whose extra
-        // results are not read), each term added in order as one by one.
+        // [`LANES`] quads at a time (the last group padded with its last quad, whose extra
+        // results are not read), each term added in order as one by one. Its own loop rather
+        // than `Setup::visit_feasible`: the corners are moved here per trial point, and a
+        // shared loop taking them through a closure measured slower (coins on one thread
+        // 0.260 → 0.293 s).
         for group in self.corners.chunks(LANES) {
             let quads: [[Point; 4]; LANES] = std::array::from_fn(|l| {
                 group[l.min(group.len() - 1)]
