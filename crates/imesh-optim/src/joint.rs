@@ -19,6 +19,7 @@
 //! 0.490 → 0.427).
 
 use imesh_geom::Point;
+use rayon::prelude::*;
 
 use crate::repair::corners_value;
 use crate::slide::Sliders;
@@ -33,33 +34,57 @@ const FIRST_STEP: f64 = 0.05;
 /// A slider stays this share of its starting gap away from either neighbour on its chain.
 const MARGIN: f64 = 0.05;
 
-/// One moving point of a patch.
+/// Most patches solved side by side. The poor quads are taken in order, and a batch is the
+/// longest run of them (up to this many) none of which reads a point that an earlier one in
+/// the run may move; they are solved in parallel and kept or dropped in order, so the result is
+/// that of solving them one after the other, on any number of threads. A constant, not the
+/// thread count: the batches, hence nothing else, would depend on the machine.
+const BATCH: usize = 32;
+
+/// One moving point of a patch; `at` is its index among the patch's points.
 #[derive(Clone, Copy, Debug)]
 enum Mover {
     /// A free quad vertex at `base`, moved by `scale` times its two variables.
-    Free {
-        vertex: u32,
-        base: Point,
-        scale: f64,
-    },
-    /// Slider `slider` (quad vertex `vertex`) at `base` along its chain, moved by `scale` times
-    /// its variable, at least `margin` from its neighbours along the chain.
+    Free { at: u32, base: Point, scale: f64 },
+    /// Slider `slider` at `base` along its chain, moved by `scale` times its variable, at least
+    /// `margin` from its neighbours along the chain (`ends`).
     Slider {
         slider: u32,
-        vertex: u32,
+        at: u32,
         base: f64,
         scale: f64,
         margin: f64,
+        ends: [Along; 2],
     },
+}
+
+/// Where a slider's neighbour on its chain is: held where it is, or the patch's mover `k`.
+#[derive(Clone, Copy, Debug)]
+enum Along {
+    Held(f64),
+    Mover(usize),
 }
 
 /// Moves the free vertices (not `fixed`) and the sliders around each quad whose shape is under
 /// `bar` (the poorest first) together, by [`Powell`]'s method, to raise the patch's smallest
 /// scaled Jacobian and then its smallest shape ([`corners_value`]), every quad held to the
 /// floors of `setup`, the energy the patches add (over all of them) at most `slack`. `around`
-/// lists the quads around each vertex of `points`. Returns how many patches moved. Sequential
-/// and in a fixed order: the same on any number of threads.
+/// lists the quads around each vertex of `points`. Returns how many patches moved. The same
+/// as one patch after the other in a fixed order, on any number of threads.
 pub(crate) fn repair_jointly(
+    points: &mut [Point],
+    around: &Rows<u32>,
+    fixed: &[bool],
+    sliders: &mut Sliders,
+    setup: &Setup,
+    bar: f64,
+    slack: f64,
+) -> usize {
+    repair_in_batches::<BATCH>(points, around, fixed, sliders, setup, bar, slack)
+}
+
+/// [`repair_jointly`] with at most `B` patches solved side by side.
+fn repair_in_batches<const B: usize>(
     points: &mut [Point],
     around: &Rows<u32>,
     fixed: &[bool],
@@ -74,69 +99,259 @@ pub(crate) fn repair_jointly(
         .collect();
     poor.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let slider_of = sliders.slider_of_vertices(points.len());
+    let context = Context {
+        around,
+        fixed,
+        slider_of: &slider_of,
+        setup,
+    };
+    // The batch that may move each point (a point a batch's patch reads must not be there).
+    let mut moving_in = vec![0u32; points.len()];
     let mut moved = 0;
-    for (_, q) in poor {
-        if setup.shape(points, q as usize) >= bar {
-            continue;
-        }
-        // The patch: the corners of the quads around the poor quad's corners.
-        let mut patch: Vec<u32> = setup.quads[q as usize]
-            .iter()
-            .flat_map(|&v| around.row(v as usize))
-            .flat_map(|&r| setup.quads[r as usize])
-            .collect();
-        patch.sort_unstable();
-        patch.dedup();
-        let movers = movers(&patch, fixed, &slider_of, sliders, points, setup, around);
-        // Every quad a mover is a corner of.
-        let mut touched: Vec<u32> = movers
-            .iter()
-            .flat_map(|m| around.row(m.vertex() as usize).iter().copied())
-            .collect();
-        touched.sort_unstable();
-        touched.dedup();
-        let Some(start) = corners_value(&touched, points, setup, bar) else {
-            continue;
-        };
-        let energy_before = energy(&touched, points, setup);
-        let n = movers.iter().map(Mover::variables).sum();
-        if n == 0 {
-            continue;
-        }
-        // Where the movers are, to put them back exactly: a slider's point re-evaluated on its
-        // curve can differ in the last bits from the vertex it stands for.
-        let saved: Vec<Point> = movers.iter().map(|m| points[m.vertex() as usize]).collect();
-        let cost = |x: &Vec<f64>| -> f64 {
-            if place(&movers, x, points, sliders) {
-                shortfall(&touched, points, setup, bar)
-            } else {
-                f64::INFINITY
+    let mut next = 0;
+    let mut stamp = 0;
+    while next < poor.len() {
+        stamp += 1;
+        let mut patches = Vec::new();
+        while let Some(&(_, q)) = poor.get(next) {
+            if patches.len() == B {
+                break;
             }
-        };
-        let (x, _) = Powell::new(FIRST_STEP).minimise(cost, vec![0.0; n], ITERATIONS);
-        let better = place(&movers, &x, points, sliders)
-            && corners_value(&touched, points, setup, bar)
-                .is_some_and(|f| f.0 > start.0 || (f.0 == start.0 && f.1 > start.1));
-        let added = energy(&touched, points, setup) - energy_before;
-        if better && added <= slack {
-            slack -= added;
-            moved += 1;
-        } else {
-            for (m, &point) in movers.iter().zip(&saved) {
-                if let Mover::Slider { slider, base, .. } = *m {
-                    sliders.place(slider as usize, base);
+            match context.plan(q, points, sliders, bar, |v| moving_in[v as usize] == stamp) {
+                Plan::Conflict => break,
+                Plan::Skip => {}
+                Plan::Patch(patch) => {
+                    for m in &patch.movers {
+                        moving_in[patch.points[m.at()] as usize] = stamp;
+                    }
+                    patches.push(patch);
                 }
-                points[m.vertex() as usize] = point;
+            }
+            next += 1;
+        }
+        let (view, sliders_view) = (&*points, &*sliders);
+        let outcomes: Vec<Option<Outcome>> = patches
+            .par_iter()
+            .map(|patch| patch.solve(view, sliders_view, setup, bar))
+            .collect();
+        for (patch, outcome) in patches.iter().zip(outcomes) {
+            let Some(outcome) = outcome else {
+                continue;
+            };
+            if outcome.added <= slack {
+                slack -= outcome.added;
+                moved += 1;
+                for (m, &along) in patch.movers.iter().zip(&outcome.along) {
+                    if let Mover::Slider { slider, .. } = *m {
+                        sliders.place(slider as usize, along);
+                    }
+                    points[patch.points[m.at()] as usize] = outcome.points[m.at()];
+                }
             }
         }
     }
     moved
 }
 
+/// What planning a poor quad's patch gives.
+enum Plan {
+    /// It reads a point that a patch of the batch may move: it waits for the next batch.
+    Conflict,
+    /// It has nothing to do (its quad is no longer poor, or nothing around it may move).
+    Skip,
+    Patch(Patch),
+}
+
+/// The mesh's fixed data a patch is planned from.
+struct Context<'a> {
+    around: &'a Rows<u32>,
+    fixed: &'a [bool],
+    slider_of: &'a [u32],
+    setup: &'a Setup<'a>,
+}
+
+/// A poor quad's patch as a problem of its own: its points (the corners of every quad a mover
+/// is a corner of), those quads over them, their floors, and the movers.
+struct Patch {
+    points: Vec<u32>,
+    quads: Vec<[u32; 4]>,
+    quality_floors: Vec<f64>,
+    shape_floors: Vec<f64>,
+    jacobian_floors: Vec<f64>,
+    movers: Vec<Mover>,
+}
+
+/// Where a solved patch's points went, and its movers along their chains (a free one's entry
+/// unused), and the energy that added.
+struct Outcome {
+    points: Vec<Point>,
+    along: Vec<f64>,
+    added: f64,
+}
+
+impl Context<'_> {
+    /// Plans poor quad `q`'s patch over `points` as they are, unless it reads a point for which
+    /// `taken` is true.
+    fn plan(
+        &self,
+        q: u32,
+        points: &[Point],
+        sliders: &Sliders,
+        bar: f64,
+        taken: impl Fn(u32) -> bool,
+    ) -> Plan {
+        let setup = self.setup;
+        let corners = setup.quads[q as usize];
+        if corners.iter().any(|&v| taken(v)) {
+            return Plan::Conflict;
+        }
+        if setup.shape(points, q as usize) >= bar {
+            return Plan::Skip;
+        }
+        // The patch: the corners of the quads around the poor quad's corners.
+        let mut patch: Vec<u32> = corners
+            .iter()
+            .flat_map(|&v| self.around.row(v as usize))
+            .flat_map(|&r| setup.quads[r as usize])
+            .collect();
+        patch.sort_unstable();
+        patch.dedup();
+        patch.retain(|&v| !self.fixed[v as usize] || self.slider_of[v as usize] != u32::MAX);
+        if patch.is_empty() {
+            return Plan::Skip;
+        }
+        // Every quad a mover is a corner of, and their corners.
+        let mut touched: Vec<u32> = patch
+            .iter()
+            .flat_map(|&v| self.around.row(v as usize).iter().copied())
+            .collect();
+        touched.sort_unstable();
+        touched.dedup();
+        let mut vertices: Vec<u32> = touched
+            .iter()
+            .flat_map(|&r| setup.quads[r as usize])
+            .collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        let local = |v: u32| vertices.binary_search(&v).unwrap_or(usize::MAX);
+        // A slider also reads where its neighbours on the chain are.
+        let ends = |v: u32| sliders.neighbours(self.slider_of[v as usize] as usize);
+        let read_elsewhere = patch
+            .iter()
+            .filter(|&&v| self.fixed[v as usize])
+            .flat_map(|&v| ends(v).map(|(u, _)| u));
+        if vertices.iter().copied().chain(read_elsewhere).any(&taken) {
+            return Plan::Conflict;
+        }
+        let slider_mover = |slider: u32| {
+            patch
+                .iter()
+                .position(|&v| self.fixed[v as usize] && self.slider_of[v as usize] == slider)
+        };
+        let movers = patch
+            .iter()
+            .map(|&v| {
+                let at = local(v) as u32;
+                if !self.fixed[v as usize] {
+                    let base = points[v as usize];
+                    let (mut sum, mut count) = (0.0, 0usize);
+                    for &r in self.around.row(v as usize) {
+                        for u in setup.quads[r as usize] {
+                            if u != v {
+                                sum += points[u as usize].distance_squared(base).sqrt();
+                                count += 1;
+                            }
+                        }
+                    }
+                    Mover::Free {
+                        at,
+                        base,
+                        scale: sum / count.max(1) as f64,
+                    }
+                } else {
+                    let slider = self.slider_of[v as usize];
+                    let [lo, at_now, hi] = sliders.gap(slider as usize);
+                    let [(_, before), (_, after)] = ends(v);
+                    let end = |neighbour: Option<u32>, held: f64| match neighbour
+                        .and_then(slider_mover)
+                    {
+                        Some(k) => Along::Mover(k),
+                        None => Along::Held(held),
+                    };
+                    Mover::Slider {
+                        slider,
+                        at,
+                        base: at_now,
+                        scale: 0.5 * (hi - lo),
+                        margin: MARGIN * (hi - lo),
+                        ends: [end(before, lo), end(after, hi)],
+                    }
+                }
+            })
+            .collect();
+        let quads = touched
+            .iter()
+            .map(|&r| setup.quads[r as usize].map(|v| local(v) as u32))
+            .collect();
+        let floors = |of: &[f64]| touched.iter().map(|&r| of[r as usize]).collect();
+        Plan::Patch(Patch {
+            quality_floors: floors(setup.quality_floors),
+            shape_floors: floors(setup.shape_floors),
+            jacobian_floors: floors(setup.jacobian_floors),
+            points: vertices,
+            quads,
+            movers,
+        })
+    }
+}
+
+impl Patch {
+    /// Solves the patch over `points` and `sliders` as they are: its outcome if its smallest
+    /// scaled Jacobian, then its smallest shape, rose.
+    fn solve(
+        &self,
+        points: &[Point],
+        sliders: &Sliders,
+        setup: &Setup,
+        bar: f64,
+    ) -> Option<Outcome> {
+        let setup = Setup {
+            quads: &self.quads,
+            quality_floors: &self.quality_floors,
+            shape_floors: &self.shape_floors,
+            jacobian_floors: &self.jacobian_floors,
+            ..*setup
+        };
+        let all: Vec<u32> = (0..self.quads.len() as u32).collect();
+        let mut local: Vec<Point> = self.points.iter().map(|&v| points[v as usize]).collect();
+        let start = corners_value(&all, &local, &setup, bar)?;
+        let energy_before = energy(&all, &local, &setup);
+        let n = self.movers.iter().map(Mover::variables).sum();
+        let mut along = vec![0.0; self.movers.len()];
+        let cost = |x: &Vec<f64>| -> f64 {
+            if place(&self.movers, x, &mut local, &mut along, sliders) {
+                shortfall(&all, &local, &setup, bar)
+            } else {
+                f64::INFINITY
+            }
+        };
+        let (x, _) = Powell::new(FIRST_STEP).minimise(cost, vec![0.0; n], ITERATIONS);
+        let better = place(&self.movers, &x, &mut local, &mut along, sliders)
+            && corners_value(&all, &local, &setup, bar)
+                .is_some_and(|f| f.0 > start.0 || (f.0 == start.0 && f.1 > start.1));
+        better.then(|| Outcome {
+            added: energy(&all, &local, &setup) - energy_before,
+            points: local,
+            along,
+        })
+    }
+}
+
 impl Mover {
-    fn vertex(&self) -> u32 {
-        let (Mover::Free { vertex, .. } | Mover::Slider { vertex, .. }) = *self;
-        vertex
+    /// Its index among its patch's points.
+    fn at(&self) -> usize {
+        let (Mover::Free { at, .. } | Mover::Slider { at, .. }) = *self;
+        at as usize
     }
 
     /// Its number of variables: a free vertex's two coordinates, a slider's position.
@@ -148,84 +363,42 @@ impl Mover {
     }
 }
 
-/// The movers among `vertices`: the free ones, each scaled by the mean length of the edges
-/// around it, and the sliders, each by half the gap between its neighbours.
-fn movers(
-    vertices: &[u32],
-    fixed: &[bool],
-    slider_of: &[u32],
+/// Puts the movers at `x` (into `points`, and each slider's position along its chain into
+/// `along`); false when a slider comes within its margin of a neighbour (or passes it).
+fn place(
+    movers: &[Mover],
+    x: &[f64],
+    points: &mut [Point],
+    along: &mut [f64],
     sliders: &Sliders,
-    points: &[Point],
-    setup: &Setup,
-    around: &Rows<u32>,
-) -> Vec<Mover> {
-    vertices
-        .iter()
-        .filter_map(|&v| {
-            if !fixed[v as usize] {
-                let base = points[v as usize];
-                let (mut sum, mut count) = (0.0, 0usize);
-                for &r in around.row(v as usize) {
-                    for u in setup.quads[r as usize] {
-                        if u != v {
-                            sum += points[u as usize].distance_squared(base).sqrt();
-                            count += 1;
-                        }
-                    }
-                }
-                Some(Mover::Free {
-                    vertex: v,
-                    base,
-                    scale: sum / count.max(1) as f64,
-                })
-            } else if slider_of[v as usize] != u32::MAX {
-                let slider = slider_of[v as usize];
-                let [lo, at, hi] = sliders.gap(slider as usize);
-                Some(Mover::Slider {
-                    slider,
-                    vertex: v,
-                    base: at,
-                    scale: 0.5 * (hi - lo),
-                    margin: MARGIN * (hi - lo),
-                })
-            } else {
-                None
-            }
-        })
-        .collect()
-}
-
-/// Puts the movers at `x`; false when a slider comes within its margin of a neighbour (or
-/// passes it).
-fn place(movers: &[Mover], x: &[f64], points: &mut [Point], sliders: &mut Sliders) -> bool {
+) -> bool {
     let mut k = 0;
-    for m in movers {
+    for (m, a) in movers.iter().zip(along.iter_mut()) {
         match *m {
-            Mover::Free {
-                vertex,
-                base,
-                scale,
-            } => {
-                points[vertex as usize] =
-                    Point::new(base.x + scale * x[k], base.y + scale * x[k + 1]);
+            Mover::Free { at, base, scale } => {
+                points[at as usize] = Point::new(base.x + scale * x[k], base.y + scale * x[k + 1]);
                 k += 2;
             }
             Mover::Slider {
                 slider,
-                vertex,
+                at,
                 base,
                 scale,
                 ..
             } => {
-                points[vertex as usize] = sliders.place(slider as usize, base + scale * x[k]);
+                *a = base + scale * x[k];
+                points[at as usize] = sliders.point(slider as usize, *a);
                 k += 1;
             }
         }
     }
-    movers.iter().all(|m| match *m {
+    movers.iter().zip(along.iter()).all(|(m, &at)| match *m {
         Mover::Free { .. } => true,
-        Mover::Slider { slider, margin, .. } => {
-            let [lo, at, hi] = sliders.gap(slider as usize);
+        Mover::Slider { margin, ends, .. } => {
+            let [lo, hi] = ends.map(|end| match end {
+                Along::Held(a) => a,
+                Along::Mover(k) => along[k],
+            });
             at - lo > margin && hi - at > margin
         }
     })
@@ -266,7 +439,7 @@ fn shortfall(quads: &[u32], points: &[Point], setup: &Setup, bar: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::repair_jointly;
+    use super::{repair_in_batches, repair_jointly};
     use crate::repair::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::slide::Sliders;
     use crate::variables::Rows;
@@ -274,6 +447,9 @@ mod tests {
     use imesh_geom::Point;
     use imesh_quality::quad::{scaled_jacobian, shape};
     use proptest::prelude::*;
+
+    /// The joint repair, solving a given number of patches side by side.
+    type Repair = fn(&mut [Point], &Rows<u32>, &[bool], &mut Sliders, &Setup, f64, f64) -> usize;
 
     fn corners(quad: &[u32; 4], points: &[Point]) -> [[f64; 2]; 4] {
         quad.map(|v| [points[v as usize].x, points[v as usize].y])
@@ -435,6 +611,51 @@ mod tests {
             let held = repaired(0.0);
             let energy = |points: &[Point]| super::energy(&all, points, &setup);
             prop_assert!(energy(&held) <= energy(&before) + 1e-12);
+        }
+
+        /// On a jittered 8 × 8 grid, its inside free, with some energy to give back or none:
+        /// patches solved side by side, a few or many at a time, end where solving them one
+        /// after the other does, to the bit.
+        #[test]
+        fn batches_of_patches_end_where_one_patch_at_a_time_does(
+            jitter in proptest::collection::vec((-0.4f64..0.4, -0.4f64..0.4), 64),
+            slack in prop_oneof![Just(0.0), 0.0f64..0.5, Just(f64::INFINITY)],
+        ) {
+            let n = 8u32;
+            let fixed: Vec<bool> = (0..n * n)
+                .map(|k| k % n == 0 || k / n == 0 || k % n == n - 1 || k / n == n - 1)
+                .collect();
+            let before: Vec<Point> = (0..n * n)
+                .map(|k| {
+                    let inside = !fixed[k as usize];
+                    let (dx, dy) = if inside { jitter[k as usize] } else { (0.0, 0.0) };
+                    Point::new(f64::from(k % n) + dx, f64::from(k / n) + dy)
+                })
+                .collect();
+            let quads = grid_quads(n);
+            prop_assume!(quads.iter().all(|q| scaled_jacobian(&corners(q, &before)) > 0.0));
+            let floors = floors(&quads, &before);
+            let none = vec![0.0; quads.len()];
+            let setup = setup(&quads, &floors, &none);
+            let around = around(&quads, (n * n) as usize);
+            let repaired = |batched: Repair| {
+                let mut points = before.clone();
+                let mut sliders = Sliders::default();
+                let bar = REPAIR_JACOBIAN;
+                let moved = batched(&mut points, &around, &fixed, &mut sliders, &setup, bar, slack);
+                (moved, points)
+            };
+            let one = repaired(repair_in_batches::<1>);
+            let batched: [(usize, Repair); 3] = [
+                (2, repair_in_batches::<2>),
+                (5, repair_in_batches::<5>),
+                (64, repair_in_batches::<64>),
+            ];
+            for (batch, repair) in batched {
+                let many = repaired(repair);
+                prop_assert_eq!(many.0, one.0);
+                prop_assert!(many.1 == one.1, "batches of {} differ", batch);
+            }
         }
     }
 }

@@ -701,6 +701,11 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     })
 }
 
+/// The boundary graphs of label grids that imesh-curves' tests build.
+#[cfg(test)]
+#[path = "../../imesh-curves/tests/support/mod.rs"]
+mod support;
+
 #[cfg(test)]
 mod tests {
     use super::*;

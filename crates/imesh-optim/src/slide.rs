@@ -176,11 +176,33 @@ impl Sliders {
         [along[j - 1], along[j], along[j + 1]]
     }
 
+    /// The quad vertices before and after slider `i` on its chain, each with its slider if it
+    /// is one (not at the chain's ends).
+    pub fn neighbours(&self, i: usize) -> [(u32, Option<u32>); 2] {
+        let (c, j) = self.slot[i];
+        let vertices = &self.chains[c as usize].vertices;
+        let j = j as usize;
+        // A chain's sliders are numbered in order along it, from its second vertex to its
+        // last but one.
+        [
+            (vertices[j - 1], (j > 1).then(|| i as u32 - 1)),
+            (
+                vertices[j + 1],
+                (j + 2 < vertices.len()).then(|| i as u32 + 1),
+            ),
+        ]
+    }
+
+    /// Where slider `i` would be at `along` on its chain.
+    pub fn point(&self, i: usize, along: f64) -> Point {
+        self.chains[self.slot[i].0 as usize].point(along)
+    }
+
     /// Puts slider `i` at `along` (not checked against its neighbours) and returns its point.
     pub fn place(&mut self, i: usize, along: f64) -> Point {
         let (c, j) = self.slot[i];
         self.along[c as usize][j as usize] = along;
-        self.chains[c as usize].point(along)
+        self.point(i, along)
     }
 
     /// Sweeps over the sliders, colour by colour, until a sweep lowers the energy of the quads
@@ -340,3 +362,49 @@ const REPAIR_HALVINGS: usize = 10;
 /// Golden-section steps per solve: the bracket shrinks to 0.618²⁰ ≈ 10⁻⁴ of the gap between
 /// the neighbours.
 const GOLDEN_STEPS: usize = 20;
+
+#[cfg(test)]
+mod tests {
+    use super::Sliders;
+    use crate::support;
+    use imesh_quad::{remesh, QuadOptions};
+
+    /// On a disc's mesh: a slider's neighbours on its chain are the sliders numbered next to
+    /// it, standing where its gap says, or the chain's ends.
+    #[test]
+    fn a_sliders_neighbours_are_the_next_sliders_on_its_chain() {
+        let (w, h) = (24u32, 20u32);
+        let labels = (0..w * h)
+            .map(|i| {
+                let (x, y) = (f64::from(i % w) + 0.5, f64::from(i / w) + 0.5);
+                u32::from((x - 12.0).powi(2) + (y - 10.0).powi(2) < 40.0)
+            })
+            .collect();
+        let (_, s, curves) = support::simplified_with_curves(&support::grid(w, h, labels));
+        let r = remesh(&s.graph, &curves, &QuadOptions::default()).unwrap();
+        let sliders = Sliders::new(&r);
+        let slider_of = sliders.slider_of_vertices(r.mesh.vertices.len());
+        let (mut inner, mut ends) = (0, 0);
+        for i in 0..sliders.len() {
+            let [lo, at, hi] = sliders.gap(i);
+            for ((vertex, slider), (along, side)) in
+                sliders.neighbours(i).into_iter().zip([(lo, 0), (hi, 2)])
+            {
+                match slider {
+                    Some(n) => {
+                        inner += 1;
+                        assert_eq!(slider_of[vertex as usize], n);
+                        // Its gap's middle is our side, and its other side our middle.
+                        assert_eq!(sliders.gap(n as usize)[1], along);
+                        assert_eq!(sliders.gap(n as usize)[2 - side], at);
+                    }
+                    None => {
+                        ends += 1;
+                        assert_eq!(slider_of[vertex as usize], u32::MAX);
+                    }
+                }
+            }
+        }
+        assert!(inner > 0 && ends > 0, "{inner} inner, {ends} at chain ends");
+    }
+}
