@@ -6,7 +6,7 @@
 //! is held by its neighbours: raising its corners spoils the quad next to it, whose other
 //! corners would have to move too. Here every free vertex and every slider of the quads around
 //! a poor quad is one variable of a single [`Powell`] minimisation of how far the patch's
-//! quads are under the bar ([`shortfall`]: the Euclidean norms of the scaled Jacobians' and the
+//! quads are under the bar ([`Shortfall`]: the Euclidean norms of the scaled Jacobians' and the
 //! shapes' shortfalls), every quad held to the floors of the repair. The result is kept only
 //! when the patch's smallest scaled Jacobian, then its smallest shape, rose (the worst of
 //! neither falls), and when the energy it adds fits in what the optimiser may still give back.
@@ -328,12 +328,17 @@ impl Patch {
         let energy_before = energy(&all, &local, &setup);
         let n = self.movers.iter().map(Mover::variables).sum();
         let mut along = vec![0.0; self.movers.len()];
+        let mut shortfall = Shortfall::new(&self.movers, &self.quads, n);
         let cost = |x: &Vec<f64>| -> f64 {
-            if place(&self.movers, x, &mut local, &mut along, sliders) {
-                shortfall(&all, &local, &setup, bar)
-            } else {
-                f64::INFINITY
-            }
+            shortfall.at(
+                x,
+                &self.movers,
+                &mut local,
+                &mut along,
+                sliders,
+                &setup,
+                bar,
+            )
         };
         let (x, _) = Powell::new(FIRST_STEP).minimise(cost, vec![0.0; n], ITERATIONS);
         let better = place(&self.movers, &x, &mut local, &mut along, sliders)
@@ -352,6 +357,26 @@ impl Mover {
     fn at(&self) -> usize {
         let (Mover::Free { at, .. } | Mover::Slider { at, .. }) = *self;
         at as usize
+    }
+
+    /// Puts it at its variables, the first of `x` (into `points`, and a slider's position
+    /// along its chain into `along`).
+    fn place(&self, x: &[f64], points: &mut [Point], along: &mut f64, sliders: &Sliders) {
+        match *self {
+            Mover::Free { at, base, scale } => {
+                points[at as usize] = Point::new(base.x + scale * x[0], base.y + scale * x[1]);
+            }
+            Mover::Slider {
+                slider,
+                at,
+                base,
+                scale,
+                ..
+            } => {
+                *along = base + scale * x[0];
+                points[at as usize] = sliders.point(slider as usize, *along);
+            }
+        }
     }
 
     /// Its number of variables: a free vertex's two coordinates, a slider's position.
@@ -374,25 +399,16 @@ fn place(
 ) -> bool {
     let mut k = 0;
     for (m, a) in movers.iter().zip(along.iter_mut()) {
-        match *m {
-            Mover::Free { at, base, scale } => {
-                points[at as usize] = Point::new(base.x + scale * x[k], base.y + scale * x[k + 1]);
-                k += 2;
-            }
-            Mover::Slider {
-                slider,
-                at,
-                base,
-                scale,
-                ..
-            } => {
-                *a = base + scale * x[k];
-                points[at as usize] = sliders.point(slider as usize, *a);
-                k += 1;
-            }
-        }
+        m.place(&x[k..], points, a, sliders);
+        k += m.variables();
     }
-    movers.iter().zip(along.iter()).all(|(m, &at)| match *m {
+    clear_of_neighbours(movers, along)
+}
+
+/// Whether every slider among `movers` (at `along`) is more than its margin from either
+/// neighbour on its chain.
+fn clear_of_neighbours(movers: &[Mover], along: &[f64]) -> bool {
+    movers.iter().zip(along).all(|(m, &at)| match *m {
         Mover::Free { .. } => true,
         Mover::Slider { margin, ends, .. } => {
             let [lo, hi] = ends.map(|end| match end {
@@ -404,6 +420,109 @@ fn place(
     })
 }
 
+/// How far a patch's quads are under the bar: the Euclidean norms of their scaled Jacobians'
+/// and their shapes' shortfalls (the quads under `bar` only); infinite where a quad is invalid
+/// or under a floor, or a slider too close to a neighbour. The smallest alone leaves the line
+/// searches flat wherever two quads share it; the sum spreads the gain over many quads instead
+/// of raising the worst.
+///
+/// Kept quad by quad: most of Powell's line searches move one variable, hence one mover, and
+/// only the quads of the movers that moved since the last call are scored again. The sums run
+/// over every quad in order, so the value is the one scoring them all gives, to the bit.
+struct Shortfall {
+    /// Per mover, the quads it is a corner of.
+    quads_of: Rows<u32>,
+    /// Per quad, its squared shortfalls (scaled Jacobian, shape; 0 at or over the bar), `None`
+    /// where it is invalid or under a floor.
+    terms: Vec<Option<[f64; 2]>>,
+    /// The variables of the last call (NaN before the first: every mover moves).
+    last: Vec<f64>,
+    /// Scratch: the quads to score, and whether each is listed.
+    stale: Vec<u32>,
+    listed: Vec<bool>,
+}
+
+impl Shortfall {
+    fn new(movers: &[Mover], quads: &[[u32; 4]], variables: usize) -> Self {
+        let points = quads.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+        let mut mover_of = vec![u32::MAX; points];
+        for (k, m) in movers.iter().enumerate() {
+            mover_of[m.at()] = k as u32;
+        }
+        let pairs: Vec<(u32, u32)> = quads
+            .iter()
+            .enumerate()
+            .flat_map(|(q, quad)| quad.map(|v| (mover_of[v as usize], q as u32)))
+            .filter(|&(m, _)| m != u32::MAX)
+            .collect();
+        Self {
+            quads_of: Rows::from_pairs(movers.len(), &pairs),
+            terms: vec![None; quads.len()],
+            last: vec![f64::NAN; variables],
+            stale: Vec::new(),
+            listed: vec![false; quads.len()],
+        }
+    }
+
+    /// The shortfall with the movers at `x` (put there, as [`place`] does).
+    #[allow(clippy::too_many_arguments)]
+    fn at(
+        &mut self,
+        x: &[f64],
+        movers: &[Mover],
+        points: &mut [Point],
+        along: &mut [f64],
+        sliders: &Sliders,
+        setup: &Setup,
+        bar: f64,
+    ) -> f64 {
+        let mut k = 0;
+        for (i, (m, a)) in movers.iter().zip(along.iter_mut()).enumerate() {
+            let n = m.variables();
+            // Not `==`: the NaN of the first call differs from everything.
+            if x[k..k + n] != self.last[k..k + n] {
+                m.place(&x[k..], points, a, sliders);
+                for &q in self.quads_of.row(i) {
+                    if !std::mem::replace(&mut self.listed[q as usize], true) {
+                        self.stale.push(q);
+                    }
+                }
+            }
+            k += n;
+        }
+        self.last.copy_from_slice(x);
+        let mut stale = self.stale.iter();
+        setup.visit_feasible(&self.stale, points, |p, quality| {
+            let Some(&q) = stale.next() else {
+                return false;
+            };
+            self.listed[q as usize] = false;
+            self.terms[q as usize] = quality.map(|(_, s)| {
+                if s < bar {
+                    let j = crate::energy::jacobian_under(p, bar);
+                    [(bar - j).max(0.0).powi(2), (bar - s) * (bar - s)]
+                } else {
+                    [0.0; 2]
+                }
+            });
+            true
+        });
+        self.stale.clear();
+        if !clear_of_neighbours(movers, along) {
+            return f64::INFINITY;
+        }
+        let (mut jacobian, mut shape) = (0.0, 0.0);
+        for term in &self.terms {
+            let Some([j, s]) = *term else {
+                return f64::INFINITY;
+            };
+            jacobian += j;
+            shape += s;
+        }
+        jacobian.sqrt() + shape.sqrt()
+    }
+}
+
 /// The energy `Σ (1 − s)²` of `quads`.
 fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
     quads
@@ -412,34 +531,9 @@ fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
         .sum()
 }
 
-/// How far `quads` are under `bar`: the Euclidean norms of their scaled Jacobians' and their
-/// shapes' shortfalls (the quads under `bar` only); infinite where a quad is invalid or under a
-/// floor of `setup`. The smallest alone leaves the line searches flat wherever two quads share
-/// it; the sum spreads the gain over many quads instead of raising the worst.
-fn shortfall(quads: &[u32], points: &[Point], setup: &Setup, bar: f64) -> f64 {
-    let (mut jacobian, mut shape) = (0.0, 0.0);
-    let mut feasible = true;
-    setup.visit_feasible(quads, points, |p, quality| {
-        let Some((_, s)) = quality else {
-            feasible = false;
-            return false;
-        };
-        if s < bar {
-            let j = crate::energy::jacobian_under(p, bar);
-            shape += (bar - s) * (bar - s);
-            jacobian += (bar - j).max(0.0).powi(2);
-        }
-        true
-    });
-    if !feasible {
-        return f64::INFINITY;
-    }
-    jacobian.sqrt() + shape.sqrt()
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{repair_in_batches, repair_jointly};
+    use super::{repair_in_batches, repair_jointly, Mover, Shortfall};
     use crate::repair::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::slide::Sliders;
     use crate::variables::Rows;
@@ -611,6 +705,54 @@ mod tests {
             let held = repaired(0.0);
             let energy = |points: &[Point]| super::energy(&all, points, &setup);
             prop_assert!(energy(&held) <= energy(&before) + 1e-12);
+        }
+
+        /// On a jittered 5 × 5 grid, its nine inside vertices moving: the shortfall kept quad by
+        /// quad, after moves of one variable or of all, is the one scoring every quad again,
+        /// to the bit.
+        #[test]
+        fn the_shortfall_kept_quad_by_quad_is_the_shortfall_of_all_the_quads(
+            jitter in proptest::collection::vec((-0.3f64..0.3, -0.3f64..0.3), 25),
+            moves in proptest::collection::vec((0usize..19, -0.6f64..0.6), 1..40),
+        ) {
+            let n = 5u32;
+            let inside = |k: u32| k % n != 0 && k / n != 0 && k % n != n - 1 && k / n != n - 1;
+            let mut points: Vec<Point> = (0..n * n)
+                .map(|k| {
+                    let (dx, dy) = if inside(k) { jitter[k as usize] } else { (0.0, 0.0) };
+                    Point::new(f64::from(k % n) + dx, f64::from(k / n) + dy)
+                })
+                .collect();
+            let quads = grid_quads(n);
+            // No floors, and a bar most quads are under: every quad counts.
+            let floors = (vec![0.0; quads.len()], vec![f64::NEG_INFINITY; quads.len()]);
+            let setup = setup(&quads, &floors, &floors.0);
+            let bar = 0.95;
+            let movers: Vec<Mover> = (0..n * n)
+                .filter(|&k| inside(k))
+                .map(|k| Mover::Free { at: k, base: points[k as usize], scale: 0.5 })
+                .collect();
+            let sliders = Sliders::default();
+            let mut along = vec![0.0; movers.len()];
+            let mut kept = Shortfall::new(&movers, &quads, 18);
+            let mut x = vec![0.0; 18];
+            let mut finite = 0;
+            for (i, value) in moves {
+                // 18 moves every variable at once.
+                if i == 18 {
+                    x.iter_mut().for_each(|x| *x = value);
+                } else {
+                    x[i] = value;
+                }
+                let got = kept.at(&x, &movers, &mut points, &mut along, &sliders, &setup, bar);
+                let mut fresh_points = points.clone();
+                let mut fresh = Shortfall::new(&movers, &quads, 18);
+                let all = fresh.at(&x, &movers, &mut fresh_points, &mut along, &sliders, &setup, bar);
+                prop_assert_eq!(got.to_bits(), all.to_bits(), "{} against {}", got, all);
+                finite += usize::from(got.is_finite());
+            }
+            // The first move leaves most of the grid as it was, every quad valid.
+            prop_assert!(finite > 0);
         }
 
         /// On a jittered 8 × 8 grid, its inside free, with some energy to give back or none:
