@@ -21,6 +21,7 @@
 use imesh_geom::Point;
 use rayon::prelude::*;
 
+use crate::batches::{Scheduler, Subproblem};
 use crate::repair::corners_value;
 use crate::slide::Sliders;
 use crate::variables::Rows;
@@ -34,11 +35,10 @@ const FIRST_STEP: f64 = 0.05;
 /// A slider stays this share of its starting gap away from either neighbour on its chain.
 const MARGIN: f64 = 0.05;
 
-/// Most patches solved side by side. The poor quads are taken in order, and a batch is the
-/// longest run of them (up to this many) none of which reads a point that an earlier one in
-/// the run may move; they are solved in parallel and kept or dropped in order, so the result is
-/// that of solving them one after the other, on any number of threads. A constant, not the
-/// thread count: the batches, hence nothing else, would depend on the machine.
+/// Most patches solved side by side: the poor quads are taken in order, up to the first whose
+/// patch reads a point that an earlier one may move ([`Scheduler::in_order`]), solved in
+/// parallel and kept or dropped in order, so the result is that of solving them one after the
+/// other. A constant, not the thread count, so that the batches depend on nothing else.
 const BATCH: usize = 32;
 
 /// One moving point of a patch; `at` is its index among the patch's points.
@@ -105,36 +105,34 @@ fn repair_in_batches<const B: usize>(
         slider_of: &slider_of,
         setup,
     };
-    // The batch that may move each point (a point a batch's patch reads must not be there).
-    let mut moving_in = vec![0u32; points.len()];
+    let mut queue: Vec<Candidate> = {
+        let sliders = &*sliders;
+        poor.par_iter()
+            .map(|&(_, q)| context.candidate(q, sliders))
+            .collect()
+    };
+    // In order: the patches share the slack, and each is kept only if it fits in what the
+    // ones before it left.
+    let mut scheduler = Scheduler::in_order(points.len());
     let mut moved = 0;
-    let mut next = 0;
-    let mut stamp = 0;
-    while next < poor.len() {
-        stamp += 1;
-        let mut patches = Vec::new();
-        while let Some(&(_, q)) = poor.get(next) {
-            if patches.len() == B {
-                break;
-            }
-            match context.plan(q, points, sliders, bar, |v| moving_in[v as usize] == stamp) {
-                Plan::Conflict => break,
-                Plan::Skip => {}
-                Plan::Patch(patch) => {
-                    for m in &patch.movers {
-                        moving_in[patch.points[m.at()] as usize] = stamp;
-                    }
-                    patches.push(patch);
-                }
-            }
-            next += 1;
-        }
+    while !queue.is_empty() {
+        let now = scheduler.take(
+            &mut queue,
+            B,
+            |c, reads| reads.extend_from_slice(&c.reads),
+            |c, moves| moves.extend_from_slice(&c.movers),
+            |c| c.movers.is_empty() || setup.shape(points, c.quad as usize) >= bar,
+        );
         let (view, sliders_view) = (&*points, &*sliders);
-        let outcomes: Vec<Option<Outcome>> = patches
+        let solved: Vec<(Patch, Option<Outcome>)> = now
             .par_iter()
-            .map(|patch| patch.solve(view, sliders_view, setup, bar))
+            .map(|c| {
+                let patch = context.patch(c, view, sliders_view);
+                let outcome = patch.solve(view, sliders_view, setup, bar);
+                (patch, outcome)
+            })
             .collect();
-        for (patch, outcome) in patches.iter().zip(outcomes) {
+        for (patch, outcome) in solved {
             let Some(outcome) = outcome else {
                 continue;
             };
@@ -145,7 +143,7 @@ fn repair_in_batches<const B: usize>(
                     if let Mover::Slider { slider, .. } = *m {
                         sliders.place(slider as usize, along);
                     }
-                    points[patch.points[m.at()] as usize] = outcome.points[m.at()];
+                    points[patch.sub.points[m.at()] as usize] = outcome.points[m.at()];
                 }
             }
         }
@@ -153,13 +151,15 @@ fn repair_in_batches<const B: usize>(
     moved
 }
 
-/// What planning a poor quad's patch gives.
-enum Plan {
-    /// It reads a point that a patch of the batch may move: it waits for the next batch.
-    Conflict,
-    /// It has nothing to do (its quad is no longer poor, or nothing around it may move).
-    Skip,
-    Patch(Patch),
+/// A poor quad and what its patch is, whatever the points: its movers (the free vertices and
+/// the sliders among the corners of the quads around its corners), the quads they are corners
+/// of, and the points its search reads (those quads' corners and the sliders' neighbours on
+/// their chains).
+struct Candidate {
+    quad: u32,
+    movers: Vec<u32>,
+    touched: Vec<u32>,
+    reads: Vec<u32>,
 }
 
 /// The mesh's fixed data a patch is planned from.
@@ -170,14 +170,10 @@ struct Context<'a> {
     setup: &'a Setup<'a>,
 }
 
-/// A poor quad's patch as a problem of its own: its points (the corners of every quad a mover
-/// is a corner of), those quads over them, their floors, and the movers.
+/// A poor quad's patch: every quad a mover is a corner of, as a problem of its own, and the
+/// movers.
 struct Patch {
-    points: Vec<u32>,
-    quads: Vec<[u32; 4]>,
-    quality_floors: Vec<f64>,
-    shape_floors: Vec<f64>,
-    jacobian_floors: Vec<f64>,
+    sub: Subproblem,
     movers: Vec<Mover>,
 }
 
@@ -190,68 +186,66 @@ struct Outcome {
 }
 
 impl Context<'_> {
-    /// Plans poor quad `q`'s patch over `points` as they are, unless it reads a point for which
-    /// `taken` is true.
-    fn plan(
-        &self,
-        q: u32,
-        points: &[Point],
-        sliders: &Sliders,
-        bar: f64,
-        taken: impl Fn(u32) -> bool,
-    ) -> Plan {
+    /// Poor quad `q`'s candidate patch.
+    fn candidate(&self, q: u32, sliders: &Sliders) -> Candidate {
         let setup = self.setup;
         let corners = setup.quads[q as usize];
-        if corners.iter().any(|&v| taken(v)) {
-            return Plan::Conflict;
-        }
-        if setup.shape(points, q as usize) >= bar {
-            return Plan::Skip;
-        }
-        // The patch: the corners of the quads around the poor quad's corners.
-        let mut patch: Vec<u32> = corners
+        // The corners of the quads around the poor quad's corners that may move.
+        let mut movers: Vec<u32> = corners
             .iter()
             .flat_map(|&v| self.around.row(v as usize))
             .flat_map(|&r| setup.quads[r as usize])
             .collect();
-        patch.sort_unstable();
-        patch.dedup();
-        patch.retain(|&v| !self.fixed[v as usize] || self.slider_of[v as usize] != u32::MAX);
-        if patch.is_empty() {
-            return Plan::Skip;
-        }
-        // Every quad a mover is a corner of, and their corners.
-        let mut touched: Vec<u32> = patch
+        movers.sort_unstable();
+        movers.dedup();
+        movers.retain(|&v| !self.fixed[v as usize] || self.slider_of[v as usize] != u32::MAX);
+        let mut touched: Vec<u32> = movers
             .iter()
             .flat_map(|&v| self.around.row(v as usize).iter().copied())
             .collect();
         touched.sort_unstable();
         touched.dedup();
-        let mut vertices: Vec<u32> = touched
+        let mut reads: Vec<u32> = touched
             .iter()
             .flat_map(|&r| setup.quads[r as usize])
+            .chain(corners)
+            .chain(
+                movers
+                    .iter()
+                    .filter(|&&v| self.fixed[v as usize])
+                    .flat_map(|&v| self.ends(v, sliders).map(|(u, _)| u)),
+            )
             .collect();
-        vertices.sort_unstable();
-        vertices.dedup();
-        let local = |v: u32| vertices.binary_search(&v).unwrap_or(usize::MAX);
-        // A slider also reads where its neighbours on the chain are.
-        let ends = |v: u32| sliders.neighbours(self.slider_of[v as usize] as usize);
-        let read_elsewhere = patch
-            .iter()
-            .filter(|&&v| self.fixed[v as usize])
-            .flat_map(|&v| ends(v).map(|(u, _)| u));
-        if vertices.iter().copied().chain(read_elsewhere).any(&taken) {
-            return Plan::Conflict;
+        reads.sort_unstable();
+        reads.dedup();
+        Candidate {
+            quad: q,
+            movers,
+            touched,
+            reads,
         }
+    }
+
+    /// The quad vertices before and after slider vertex `v` on its chain, and their sliders.
+    fn ends(&self, v: u32, sliders: &Sliders) -> [(u32, Option<u32>); 2] {
+        sliders.neighbours(self.slider_of[v as usize] as usize)
+    }
+
+    /// Candidate `c`'s patch over `points` and `sliders` as they are.
+    fn patch(&self, c: &Candidate, points: &[Point], sliders: &Sliders) -> Patch {
+        let setup = self.setup;
+        let sub = Subproblem::new(&c.touched, setup);
         let slider_mover = |slider: u32| {
-            patch
+            c.movers
                 .iter()
                 .position(|&v| self.fixed[v as usize] && self.slider_of[v as usize] == slider)
         };
-        let movers = patch
+        let movers = c
+            .movers
             .iter()
             .map(|&v| {
-                let at = local(v) as u32;
+                // A mover is a corner of the quads it touches.
+                let at = sub.index(v).unwrap_or(usize::MAX) as u32;
                 if !self.fixed[v as usize] {
                     let base = points[v as usize];
                     let (mut sum, mut count) = (0.0, 0usize);
@@ -271,7 +265,7 @@ impl Context<'_> {
                 } else {
                     let slider = self.slider_of[v as usize];
                     let [lo, at_now, hi] = sliders.gap(slider as usize);
-                    let [(_, before), (_, after)] = ends(v);
+                    let [(_, before), (_, after)] = self.ends(v, sliders);
                     let end = |neighbour: Option<u32>, held: f64| match neighbour
                         .and_then(slider_mover)
                     {
@@ -289,19 +283,7 @@ impl Context<'_> {
                 }
             })
             .collect();
-        let quads = touched
-            .iter()
-            .map(|&r| setup.quads[r as usize].map(|v| local(v) as u32))
-            .collect();
-        let floors = |of: &[f64]| touched.iter().map(|&r| of[r as usize]).collect();
-        Plan::Patch(Patch {
-            quality_floors: floors(setup.quality_floors),
-            shape_floors: floors(setup.shape_floors),
-            jacobian_floors: floors(setup.jacobian_floors),
-            points: vertices,
-            quads,
-            movers,
-        })
+        Patch { sub, movers }
     }
 }
 
@@ -315,20 +297,14 @@ impl Patch {
         setup: &Setup,
         bar: f64,
     ) -> Option<Outcome> {
-        let setup = Setup {
-            quads: &self.quads,
-            quality_floors: &self.quality_floors,
-            shape_floors: &self.shape_floors,
-            jacobian_floors: &self.jacobian_floors,
-            ..*setup
-        };
-        let all: Vec<u32> = (0..self.quads.len() as u32).collect();
-        let mut local: Vec<Point> = self.points.iter().map(|&v| points[v as usize]).collect();
+        let setup = self.sub.setup(setup);
+        let all: Vec<u32> = (0..self.sub.len() as u32).collect();
+        let mut local = self.sub.gather(points);
         let start = corners_value(&all, &local, &setup, bar)?;
         let energy_before = energy(&all, &local, &setup);
         let n = self.movers.iter().map(Mover::variables).sum();
         let mut along = vec![0.0; self.movers.len()];
-        let mut shortfall = Shortfall::new(&self.movers, &self.quads, n);
+        let mut shortfall = Shortfall::new(&self.movers, setup.quads, n);
         let cost = |x: &Vec<f64>| -> f64 {
             shortfall.at(
                 x,

@@ -12,6 +12,9 @@
 use imesh_geom::{Point, Triangulation};
 use imesh_quad::{ElementMesh, QuadMesh};
 
+use rayon::prelude::*;
+
+use crate::batches::{Scheduler, Subproblem};
 use crate::variables::{vertex_quads, Variables};
 use crate::Setup;
 
@@ -57,7 +60,9 @@ const HALVINGS: usize = 12;
 
 /// Raises the worst scaled Jacobians and shapes of `mesh`'s quads towards `bar`, moving its
 /// free vertices (those of the vertex mode: not on a constrained M edge of `elements`); returns
-/// how many moved. Sequential and in a fixed order: the same on any number of threads.
+/// how many moved. The same as one search after the other in a fixed order, on any number of
+/// threads: the searches run side by side where neither reads what the other moves
+/// ([`Scheduler`]).
 pub(crate) fn repair(
     t: &Triangulation,
     elements: &ElementMesh,
@@ -93,6 +98,7 @@ pub(crate) fn repair(
     // A search is a function of the corners of the quads it scores: one that found no move is
     // not run again until one of those corners has moved (the same result, unsearched).
     let mut since = Unchanged::new(vertices.len());
+    let mut scheduler = Scheduler::new(vertices.len());
     let mut vertex_failed = vec![NEVER; vars.len()];
     let mut poor_quads = first;
     for pass in 0..PASSES {
@@ -112,17 +118,29 @@ pub(crate) fn repair(
             }
         }
         let mut any = false;
-        for i in (0..vars.len()).filter(|&i| wanted[i]) {
-            let quads = vars.quads.row(i);
-            if since.unchanged(vertex_failed[i], quads, setup.quads) {
-                continue;
-            }
-            if improve(&vars, i, vertices, setup, bar) {
-                moved[i] = true;
-                any = true;
-                since.moved(&[vars.ids[i] as usize]);
-            } else {
-                vertex_failed[i] = since.now();
+        let mut queue: Vec<usize> = (0..vars.len()).filter(|&i| wanted[i]).collect();
+        while !queue.is_empty() {
+            let now = scheduler.take(
+                &mut queue,
+                BATCH,
+                |&i, reads| corners(vars.quads.row(i), setup, reads),
+                |&i, moves| moves.push(vars.ids[i]),
+                |&i| since.unchanged(vertex_failed[i], vars.quads.row(i), setup.quads),
+            );
+            let view = &*vertices;
+            let found: Vec<Option<Vec<Point>>> = now
+                .par_iter()
+                .map(|&i| search(&[vars.ids[i]], &[1], vars.quads.row(i), view, setup, bar))
+                .collect();
+            for (&i, found) in now.iter().zip(found) {
+                if let Some(found) = found {
+                    vertices[vars.ids[i] as usize] = found[0];
+                    moved[i] = true;
+                    any = true;
+                    since.moved(&[vars.ids[i]]);
+                } else {
+                    vertex_failed[i] = since.now();
+                }
             }
         }
         if !any {
@@ -140,35 +158,60 @@ pub(crate) fn repair(
     let mut quad_failed = vec![NEVER; setup.quads.len()];
     for _ in 0..PASSES {
         let mut any = false;
-        for q in poor(vertices) {
-            let free: Vec<usize> = setup.quads[q as usize]
-                .iter()
-                .filter(|&&v| variable_of[v as usize] != u32::MAX)
-                .map(|&v| v as usize)
-                .collect();
-            if free.len() < 2 {
-                continue;
-            }
-            let mut quads: Vec<u32> = free
-                .iter()
-                .flat_map(|&v| vars.quads.row(variable_of[v] as usize).iter().copied())
-                .collect();
-            quads.sort_unstable();
-            quads.dedup();
-            if since.unchanged(quad_failed[q as usize], &quads, setup.quads) {
-                continue;
-            }
-            let together: Vec<u32> = (1..1u32 << free.len())
-                .filter(|m| m.count_ones() >= 2)
-                .collect();
-            if compass(&free, &together, &quads, vertices, setup, bar) {
-                for &v in &free {
-                    moved[variable_of[v] as usize] = true;
+        // Each poor quad with two free corners or more: those corners, and their quads.
+        let mut queue: Vec<(u32, Vec<u32>, Vec<u32>)> = poor(vertices)
+            .into_iter()
+            .filter_map(|q| {
+                let free: Vec<u32> = setup.quads[q as usize]
+                    .into_iter()
+                    .filter(|&v| variable_of[v as usize] != u32::MAX)
+                    .collect();
+                if free.len() < 2 {
+                    return None;
                 }
-                any = true;
-                since.moved(&free);
-            } else {
-                quad_failed[q as usize] = since.now();
+                let mut quads: Vec<u32> = free
+                    .iter()
+                    .flat_map(|&v| {
+                        vars.quads
+                            .row(variable_of[v as usize] as usize)
+                            .iter()
+                            .copied()
+                    })
+                    .collect();
+                quads.sort_unstable();
+                quads.dedup();
+                Some((q, free, quads))
+            })
+            .collect();
+        while !queue.is_empty() {
+            let now = scheduler.take(
+                &mut queue,
+                BATCH,
+                |(_, _, quads), reads| corners(quads, setup, reads),
+                |(_, free, _), moves| moves.extend_from_slice(free),
+                |(q, _, quads)| since.unchanged(quad_failed[*q as usize], quads, setup.quads),
+            );
+            let view = &*vertices;
+            let found: Vec<Option<Vec<Point>>> = now
+                .par_iter()
+                .map(|(_, free, quads)| {
+                    let together: Vec<u32> = (1..1u32 << free.len())
+                        .filter(|m| m.count_ones() >= 2)
+                        .collect();
+                    search(free, &together, quads, view, setup, bar)
+                })
+                .collect();
+            for ((q, free, _), found) in now.iter().zip(found) {
+                if let Some(found) = found {
+                    for (&v, &p) in free.iter().zip(&found) {
+                        vertices[v as usize] = p;
+                        moved[variable_of[v as usize] as usize] = true;
+                    }
+                    any = true;
+                    since.moved(free);
+                } else {
+                    quad_failed[*q as usize] = since.now();
+                }
             }
         }
         if !any {
@@ -202,10 +245,10 @@ impl Unchanged {
     }
 
     /// Vertices `moved` have just moved.
-    fn moved(&mut self, moved: &[usize]) {
+    fn moved(&mut self, moved: &[u32]) {
         self.clock += 1;
         for &v in moved {
-            self.moved_at[v] = self.clock;
+            self.moved_at[v as usize] = self.clock;
         }
     }
 
@@ -221,12 +264,30 @@ impl Unchanged {
     }
 }
 
-/// Compass search for vertex variable `i`: the smallest of its quads' scaled Jacobians as high
-/// as the floors allow, then, at an equal smallest scaled Jacobian, the smallest of their shapes
-/// (both capped at `bar`). True when it moved.
-fn improve(vars: &Variables, i: usize, vertices: &mut [Point], setup: &Setup, bar: f64) -> bool {
-    let v = vars.ids[i] as usize;
-    compass(&[v], &[1], vars.quads.row(i), vertices, setup, bar)
+/// Searches side by side at most ([`Scheduler::take`]): enough to keep two or more threads busy,
+/// few enough that a batch's later searches seldom wait on its earlier ones.
+const BATCH: usize = 64;
+
+/// The corners of `quads` (of `setup`) into `out`.
+fn corners(quads: &[u32], setup: &Setup, out: &mut Vec<u32>) {
+    out.extend(quads.iter().flat_map(|&q| setup.quads[q as usize]));
+}
+
+/// [`compass`] over a copy of the corners of `quads`: where `moving` went, if one moved.
+fn search(
+    moving: &[u32],
+    groups: &[u32],
+    quads: &[u32],
+    vertices: &[Point],
+    setup: &Setup,
+    bar: f64,
+) -> Option<Vec<Point>> {
+    let sub = Subproblem::new(quads, setup);
+    let mut points = sub.gather(vertices);
+    let moving: Vec<usize> = moving.iter().filter_map(|&v| sub.index(v)).collect();
+    let all: Vec<u32> = (0..sub.len() as u32).collect();
+    compass(&moving, groups, &all, &mut points, &sub.setup(setup), bar)
+        .then(|| moving.iter().map(|&k| points[k]).collect())
 }
 
 /// Compass search moving the vertices `moving` (each `groups` mask a set of them stepping
