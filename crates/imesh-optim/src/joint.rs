@@ -84,6 +84,13 @@ pub(crate) fn repair_jointly(
 }
 
 /// [`repair_jointly`] with at most `B` patches solved side by side.
+///
+/// A patch is solved ahead of earlier ones that must wait ([`Scheduler::new`]) where neither
+/// reads what the other moves, and its moves are kept or dropped as it comes: the slack is then
+/// spent in another order than the poor quads'. Whether that changed which patches fit is
+/// checked once all are solved; if it did (never on the fixtures), the repair runs again from
+/// the start, taking the patches only in order ([`Scheduler::in_order`]). Either way the result
+/// is that of solving the patches one after the other.
 fn repair_in_batches<const B: usize>(
     points: &mut [Point],
     around: &Rows<u32>,
@@ -91,7 +98,7 @@ fn repair_in_batches<const B: usize>(
     sliders: &mut Sliders,
     setup: &Setup,
     bar: f64,
-    mut slack: f64,
+    slack: f64,
 ) -> usize {
     let mut poor: Vec<(f64, u32)> = (0..setup.quads.len() as u32)
         .map(|q| (setup.shape(points, q as usize), q))
@@ -105,38 +112,85 @@ fn repair_in_batches<const B: usize>(
         slider_of: &slider_of,
         setup,
     };
-    let mut queue: Vec<Candidate> = {
+    let candidates: Vec<Candidate> = {
         let sliders = &*sliders;
         poor.par_iter()
             .map(|&(_, q)| context.candidate(q, sliders))
             .collect()
     };
-    // In order: the patches share the slack, and each is kept only if it fits in what the
-    // ones before it left.
-    let mut scheduler = Scheduler::in_order(points.len());
+    let (start, start_sliders) = (points.to_vec(), sliders.clone());
+    let scheduler = Scheduler::new(points.len());
+    let (moved, mut kept) = run::<B>(
+        &context,
+        &candidates,
+        scheduler,
+        points,
+        sliders,
+        bar,
+        slack,
+    );
+    if kept_in_order(&mut kept, slack) {
+        return moved;
+    }
+    points.copy_from_slice(&start);
+    *sliders = start_sliders;
+    let scheduler = Scheduler::in_order(points.len());
+    run::<B>(
+        &context,
+        &candidates,
+        scheduler,
+        points,
+        sliders,
+        bar,
+        slack,
+    )
+    .0
+}
+
+/// Solves the patches of `candidates` (in order, at most `B` side by side, as `scheduler` takes
+/// them) and keeps those whose corners rose and whose added energy fits in what is left of
+/// `slack`. Returns how many moved, and for each patch whose corners rose: its place in
+/// `candidates`, the energy it adds, and whether it was kept.
+fn run<const B: usize>(
+    context: &Context,
+    candidates: &[Candidate],
+    mut scheduler: Scheduler,
+    points: &mut [Point],
+    sliders: &mut Sliders,
+    bar: f64,
+    mut slack: f64,
+) -> (usize, Vec<(usize, f64, bool)>) {
+    let setup = context.setup;
+    let mut queue: Vec<usize> = (0..candidates.len()).collect();
     let mut moved = 0;
+    let mut log = Vec::new();
     while !queue.is_empty() {
         let now = scheduler.take(
             &mut queue,
             B,
-            |c, reads| reads.extend_from_slice(&c.reads),
-            |c, moves| moves.extend_from_slice(&c.movers),
-            |c| c.movers.is_empty() || setup.shape(points, c.quad as usize) >= bar,
+            |&c, reads| reads.extend_from_slice(&candidates[c].reads),
+            |&c, moves| moves.extend_from_slice(&candidates[c].movers),
+            |&c| {
+                let c = &candidates[c];
+                c.movers.is_empty() || setup.shape(points, c.quad as usize) >= bar
+            },
         );
         let (view, sliders_view) = (&*points, &*sliders);
         let solved: Vec<(Patch, Option<Outcome>)> = now
             .par_iter()
-            .map(|c| {
-                let patch = context.patch(c, view, sliders_view);
+            .map(|&c| {
+                let patch = context.patch(&candidates[c], view, sliders_view);
                 let outcome = patch.solve(view, sliders_view, setup, bar);
                 (patch, outcome)
             })
             .collect();
-        for (patch, outcome) in solved {
+        for (&c, (patch, outcome)) in now.iter().zip(solved) {
             let Some(outcome) = outcome else {
                 continue;
             };
-            if outcome.added <= slack {
+            let fits = outcome.added <= slack;
+            log.push((c, outcome.added, fits));
+            if fits {
                 slack -= outcome.added;
                 moved += 1;
                 for (m, &along) in patch.movers.iter().zip(&outcome.along) {
@@ -148,7 +202,20 @@ fn repair_in_batches<const B: usize>(
             }
         }
     }
-    moved
+    (moved, log)
+}
+
+/// Whether spending `slack` on the patches of `log` ([`run`]'s) in the poor quads' order keeps
+/// the same ones.
+fn kept_in_order(log: &mut [(usize, f64, bool)], mut slack: f64) -> bool {
+    log.sort_unstable_by_key(|&(c, _, _)| c);
+    log.iter().all(|&(_, added, kept)| {
+        let fits = added <= slack;
+        if fits {
+            slack -= added;
+        }
+        fits == kept
+    })
 }
 
 /// A poor quad and what its patch is, whatever the points: its movers (the free vertices and
@@ -535,14 +602,19 @@ mod tests {
 
     /// The quads of an `n × n` grid of points, counter-clockwise.
     fn grid_quads(n: u32) -> Vec<[u32; 4]> {
-        (0..n - 1)
+        rectangle_quads(n, n)
+    }
+
+    /// The quads of a grid of points `w` wide and `h` high, row by row, counter-clockwise.
+    fn rectangle_quads(w: u32, h: u32) -> Vec<[u32; 4]> {
+        (0..h - 1)
             .flat_map(|j| {
-                (0..n - 1).map(move |i| {
+                (0..w - 1).map(move |i| {
                     [
-                        j * n + i,
-                        j * n + i + 1,
-                        (j + 1) * n + i + 1,
-                        (j + 1) * n + i,
+                        j * w + i,
+                        j * w + i + 1,
+                        (j + 1) * w + i + 1,
+                        (j + 1) * w + i,
                     ]
                 })
             })
@@ -731,31 +803,33 @@ mod tests {
             prop_assert!(finite > 0);
         }
 
-        /// On a jittered 8 × 8 grid, its inside free, with some energy to give back or none:
-        /// patches solved side by side, a few or many at a time, end where solving them one
-        /// after the other does, to the bit.
+        /// On a jittered strip of 40 × 6 points, its inside free, with energy to give back,
+        /// none, or some to win back first (a negative slack, which patches that lower the
+        /// energy enough raise: then the order they are kept in decides which fit): patches
+        /// solved side by side, a few or many at a time, ahead of those that wait, end where
+        /// solving them one after the other does, to the bit.
         #[test]
         fn batches_of_patches_end_where_one_patch_at_a_time_does(
-            jitter in proptest::collection::vec((-0.4f64..0.4, -0.4f64..0.4), 64),
-            slack in prop_oneof![Just(0.0), 0.0f64..0.5, Just(f64::INFINITY)],
+            jitter in proptest::collection::vec((-0.35f64..0.35, -0.35f64..0.35), 240),
+            slack in prop_oneof![Just(0.0), -1.5f64..0.3, Just(f64::INFINITY)],
         ) {
-            let n = 8u32;
-            let fixed: Vec<bool> = (0..n * n)
-                .map(|k| k % n == 0 || k / n == 0 || k % n == n - 1 || k / n == n - 1)
+            let (w, h) = (40u32, 6u32);
+            let fixed: Vec<bool> = (0..w * h)
+                .map(|k| k % w == 0 || k / w == 0 || k % w == w - 1 || k / w == h - 1)
                 .collect();
-            let before: Vec<Point> = (0..n * n)
+            let before: Vec<Point> = (0..w * h)
                 .map(|k| {
                     let inside = !fixed[k as usize];
                     let (dx, dy) = if inside { jitter[k as usize] } else { (0.0, 0.0) };
-                    Point::new(f64::from(k % n) + dx, f64::from(k / n) + dy)
+                    Point::new(f64::from(k % w) + dx, f64::from(k / w) + dy)
                 })
                 .collect();
-            let quads = grid_quads(n);
+            let quads = rectangle_quads(w, h);
             prop_assume!(quads.iter().all(|q| scaled_jacobian(&corners(q, &before)) > 0.0));
             let floors = floors(&quads, &before);
             let none = vec![0.0; quads.len()];
             let setup = setup(&quads, &floors, &none);
-            let around = around(&quads, (n * n) as usize);
+            let around = around(&quads, (w * h) as usize);
             let repaired = |batched: Repair| {
                 let mut points = before.clone();
                 let mut sliders = Sliders::default();
