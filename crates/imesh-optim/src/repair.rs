@@ -303,8 +303,7 @@ pub(crate) fn compass(
     setup: &Setup,
     bar: f64,
 ) -> bool {
-    let value = |vertices: &[Point]| corners_value(quads, vertices, setup, bar);
-    let Some(mut best) = value(vertices) else {
+    let Some(mut best) = corners_value(quads, vertices, setup, bar) else {
         return false;
     };
     let start: Vec<Point> = moving.iter().map(|&v| vertices[v]).collect();
@@ -335,8 +334,8 @@ pub(crate) fn compass(
                         vertices[v] = Point::new(here[k].x + dx * step, here[k].y + dy * step);
                     }
                 }
-                match value(vertices) {
-                    Some(f) if f.0 > best.0 || (f.0 == best.0 && f.1 > best.1) => {
+                match corners_value_above(quads, vertices, setup, bar, best) {
+                    Some(f) => {
                         best = f;
                         stepped = true;
                         break 'search;
@@ -370,11 +369,31 @@ pub(crate) fn corners_value(
     setup: &Setup,
     bar: f64,
 ) -> Option<(f64, f64)> {
+    corners_value_above(
+        quads,
+        vertices,
+        setup,
+        bar,
+        (f64::NEG_INFINITY, f64::NEG_INFINITY),
+    )
+}
+
+/// [`corners_value`] where it is above `best` (a higher smallest scaled Jacobian, or the same
+/// and a higher smallest shape), else `None`: the searches' test of a trial point, which stops
+/// scoring at the first quad that rules it out (both smallest values only fall, quad after
+/// quad).
+pub(crate) fn corners_value_above(
+    quads: &[u32],
+    vertices: &[Point],
+    setup: &Setup,
+    bar: f64,
+    best: (f64, f64),
+) -> Option<(f64, f64)> {
     let (mut jacobian, mut shape) = (bar, bar);
-    let mut feasible = true;
+    let mut above = true;
     setup.visit_feasible(quads, vertices, |p, quality| {
         let Some((_, s)) = quality else {
-            feasible = false;
+            above = false;
             return false;
         };
         shape = shape.min(s);
@@ -383,9 +402,10 @@ pub(crate) fn corners_value(
         if s < bar {
             jacobian = jacobian.min(crate::energy::jacobian_under(p, jacobian));
         }
-        true
+        above = jacobian > best.0 || (jacobian == best.0 && shape > best.1);
+        above
     });
-    feasible.then_some((jacobian, shape))
+    above.then_some((jacobian, shape))
 }
 
 /// The 3 × 3 grid of points (row by row) of the repairs' tests: with every point pinned but the
@@ -410,9 +430,60 @@ pub(crate) fn stalling_grid() -> Vec<Point> {
 
 #[cfg(test)]
 mod tests {
-    use super::{compass, stalling_grid, Unchanged, NEVER, REPAIR_FLOOR, REPAIR_JACOBIAN};
+    use super::{
+        compass, corners_value, corners_value_above, stalling_grid, Unchanged, NEVER, REPAIR_FLOOR,
+        REPAIR_JACOBIAN,
+    };
     use crate::{LocalSolver, Metric, Setup};
     use imesh_geom::Point;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The value above a best is the value where it beats the best, and nothing where it
+        /// does not, however early the scoring stopped: on a jittered 3 × 3 grid (some quads
+        /// invalid or under a floor), against bests on either side of it, level with it in
+        /// scaled Jacobian, and equal to it.
+        #[test]
+        fn the_value_above_a_best_is_the_value_where_it_beats_it(
+            jitter in proptest::collection::vec((-0.45f64..0.45, -0.45f64..0.45), 9),
+            best in (0.0f64..0.6, 0.0f64..0.6),
+            tie in 0u8..3,
+        ) {
+            let vertices: Vec<Point> = stalling_grid()
+                .iter()
+                .zip(&jitter)
+                .map(|(p, &(dx, dy))| Point::new(p.x + dx, p.y + dy))
+                .collect();
+            let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
+            let floors = [0.2, 0.0, 0.1, 0.0];
+            let setup = Setup {
+                quads: &quads,
+                metric: Metric::Shape,
+                average_area: 1.0,
+                quality_floors: &[0.0; 4],
+                shape_floors: &floors,
+                jacobian_floors: &floors,
+                max_sweeps: 1,
+                tolerance: 0.0,
+                local_iterations: 1,
+                local_solver: LocalSolver::Powell,
+                settled_term: 0.0,
+            };
+            let all = [0, 1, 2, 3];
+            let value = corners_value(&all, &vertices, &setup, REPAIR_JACOBIAN);
+            // Or the same smallest scaled Jacobian as the value, and either shape; or the value.
+            let best = match (value, tie) {
+                (Some((jacobian, _)), 1) => (jacobian, best.1),
+                (Some(value), 2) => value,
+                _ => best,
+            };
+            let beats = value.filter(|f| f.0 > best.0 || (f.0 == best.0 && f.1 > best.1));
+            prop_assert_eq!(
+                corners_value_above(&all, &vertices, &setup, REPAIR_JACOBIAN, best),
+                beats
+            );
+        }
+    }
 
     fn corners(quad: &[u32; 4], vertices: &[Point]) -> [[f64; 2]; 4] {
         quad.map(|v| [vertices[v as usize].x, vertices[v as usize].y])

@@ -257,20 +257,20 @@ impl Sliders {
             let margin = 0.05 * (hi - lo);
             let (lo, hi) = (lo + margin, hi - margin);
             let start = (along[j as usize], vertices[v]);
-            let mut value = |a: f64| {
+            // Where the slider at `a` beats `best`: its value there.
+            let mut above = |a: f64, best: (f64, f64)| {
                 vertices[v] = chain.point(a);
-                crate::repair::corners_value(quads, vertices, setup, bar)
+                crate::repair::corners_value_above(quads, vertices, setup, bar, best)
             };
-            let Some(mut best) = value(start.0) else {
+            let below = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+            let Some(mut best) = above(start.0, below) else {
                 vertices[v] = start.1;
                 continue;
             };
             let mut at = start.0;
-            let better =
-                |f: &(f64, f64), best: (f64, f64)| f.0 > best.0 || (f.0 == best.0 && f.1 > best.1);
             for k in 0..=REPAIR_SCAN {
                 let a = lo + (hi - lo) * k as f64 / REPAIR_SCAN as f64;
-                if let Some(f) = value(a).filter(|f| better(f, best)) {
+                if let Some(f) = above(a, best) {
                     (at, best) = (a, f);
                 }
             }
@@ -280,7 +280,7 @@ impl Sliders {
                     if !(lo..=hi).contains(&a) {
                         continue;
                     }
-                    if let Some(f) = value(a).filter(|f| better(f, best)) {
+                    if let Some(f) = above(a, best) {
                         (at, best) = (a, f);
                     }
                 }
