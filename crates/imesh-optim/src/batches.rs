@@ -156,7 +156,7 @@ impl Scheduler {
 #[cfg(test)]
 mod tests {
     use super::{Scheduler, Subproblem};
-    use crate::{LocalSolver, Metric, Setup};
+    use crate::{Metric, Setup};
     use imesh_geom::Point;
     use proptest::prelude::*;
 
@@ -175,17 +175,8 @@ mod tests {
         let quads: Vec<[u32; 4]> = (0..5).map(|i| [i, i + 1, i + 7, i + 6]).collect();
         let floors: Vec<f64> = (0..5).map(|q| 0.1 * f64::from(q)).collect();
         let setup = Setup {
-            quads: &quads,
-            metric: Metric::ShapeAndSize,
             average_area: 1.2,
-            quality_floors: &floors,
-            shape_floors: &floors,
-            jacobian_floors: &floors,
-            max_sweeps: 1,
-            tolerance: 0.0,
-            local_iterations: 1,
-            local_solver: LocalSolver::Powell,
-            settled_term: 0.0,
+            ..Setup::held(&quads, Metric::ShapeAndSize, [&floors; 3])
         };
         let picked = [3u32, 0, 4];
         let sub = Subproblem::new(&picked, &setup);

@@ -39,7 +39,7 @@ const MARGIN: f64 = 0.05;
 /// patch reads a point that an earlier one may move ([`Scheduler::in_order`]), solved in
 /// parallel and kept or dropped in order, so the result is that of solving them one after the
 /// other. A constant, not the thread count, so that the batches depend on nothing else.
-const BATCH: usize = 32;
+pub(crate) const BATCH: usize = 32;
 
 /// One moving point of a patch; `at` is its index among the patch's points.
 #[derive(Clone, Copy, Debug)]
@@ -68,22 +68,9 @@ enum Along {
 /// Moves the free vertices (not `fixed`) and the sliders around each quad whose shape is under
 /// `bar` (the poorest first) together, by [`Powell`]'s method, to raise the patch's smallest
 /// scaled Jacobian and then its smallest shape ([`corners_value`]), every quad held to the
-/// floors of `setup`, the energy the patches add (over all of them) at most `slack`. `around`
-/// lists the quads around each vertex of `points`. Returns how many patches moved. The same
-/// as one patch after the other in a fixed order, on any number of threads.
-pub(crate) fn repair_jointly(
-    points: &mut [Point],
-    around: &Rows<u32>,
-    fixed: &[bool],
-    sliders: &mut Sliders,
-    setup: &Setup,
-    bar: f64,
-    slack: f64,
-) -> usize {
-    repair_in_batches::<BATCH>(points, around, fixed, sliders, setup, bar, slack)
-}
-
-/// [`repair_jointly`] with at most `B` patches solved side by side.
+/// floors of `setup`, the energy the patches add (over all of them) at most `slack`; at most
+/// `B` patches side by side ([`BATCH`] in the optimiser). `around` lists the quads around each
+/// vertex of `points`. Returns how many patches moved.
 ///
 /// A patch is solved ahead of earlier ones that must wait ([`Scheduler::new`]) where neither
 /// reads what the other moves, and its moves are kept or dropped as it comes: the slack is then
@@ -91,7 +78,7 @@ pub(crate) fn repair_jointly(
 /// checked once all are solved; if it did (never on the fixtures), the repair runs again from
 /// the start, taking the patches only in order ([`Scheduler::in_order`]). Either way the result
 /// is that of solving the patches one after the other.
-fn repair_in_batches<const B: usize>(
+pub(crate) fn repair_jointly<const B: usize>(
     points: &mut [Point],
     around: &Rows<u32>,
     fixed: &[bool],
@@ -119,32 +106,24 @@ fn repair_in_batches<const B: usize>(
             .collect()
     };
     let (start, start_sliders) = (points.to_vec(), sliders.clone());
-    let scheduler = Scheduler::new(points.len());
-    let (moved, mut kept) = run::<B>(
-        &context,
-        &candidates,
-        scheduler,
-        points,
-        sliders,
-        bar,
-        slack,
-    );
+    let run = |scheduler, points: &mut [Point], sliders: &mut Sliders| {
+        run::<B>(
+            &context,
+            &candidates,
+            scheduler,
+            points,
+            sliders,
+            bar,
+            slack,
+        )
+    };
+    let (moved, mut kept) = run(Scheduler::new(points.len()), points, sliders);
     if kept_in_order(&mut kept, slack) {
         return moved;
     }
     points.copy_from_slice(&start);
     *sliders = start_sliders;
-    let scheduler = Scheduler::in_order(points.len());
-    run::<B>(
-        &context,
-        &candidates,
-        scheduler,
-        points,
-        sliders,
-        bar,
-        slack,
-    )
-    .0
+    run(Scheduler::in_order(points.len()), points, sliders).0
 }
 
 /// Solves the patches of `candidates` (in order, at most `B` side by side, as `scheduler` takes
@@ -576,11 +555,11 @@ fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{repair_in_batches, repair_jointly, Mover, Shortfall};
+    use super::{repair_jointly, Mover, Shortfall};
     use crate::repair::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::slide::Sliders;
     use crate::variables::Rows;
-    use crate::{LocalSolver, Metric, Setup};
+    use crate::{Metric, Setup};
     use imesh_geom::Point;
     use imesh_quality::quad::{scaled_jacobian, shape};
     use proptest::prelude::*;
@@ -641,19 +620,7 @@ mod tests {
         floors: &'a (Vec<f64>, Vec<f64>),
         none: &'a [f64],
     ) -> Setup<'a> {
-        Setup {
-            quads,
-            metric: Metric::Shape,
-            average_area: 1.0,
-            quality_floors: none,
-            shape_floors: &floors.0,
-            jacobian_floors: &floors.1,
-            max_sweeps: 1,
-            tolerance: 0.0,
-            local_iterations: 1,
-            local_solver: LocalSolver::Powell,
-            settled_term: 0.0,
-        }
+        Setup::held(quads, Metric::Shape, [none, &floors.0, &floors.1])
     }
 
     fn around(quads: &[[u32; 4]], n: usize) -> Rows<u32> {
@@ -689,7 +656,7 @@ mod tests {
         let stalled = worst(&quads, &points, scaled_jacobian);
         assert!(stalled < REPAIR_JACOBIAN - 0.05, "{stalled}");
         let before = points.clone();
-        let moved = repair_jointly(
+        let moved = repair_jointly::<{ super::BATCH }>(
             &mut points,
             &around,
             &fixed,
@@ -736,7 +703,7 @@ mod tests {
             let repaired = |slack: f64| {
                 let mut points = before.clone();
                 let mut sliders = Sliders::default();
-                repair_jointly(&mut points, &around, &fixed, &mut sliders, &setup, REPAIR_JACOBIAN, slack);
+                repair_jointly::<{ super::BATCH }>(&mut points, &around, &fixed, &mut sliders, &setup, REPAIR_JACOBIAN, slack);
                 points
             };
             let start = worst(&quads, &points, scaled_jacobian).min(REPAIR_JACOBIAN);
@@ -837,11 +804,11 @@ mod tests {
                 let moved = batched(&mut points, &around, &fixed, &mut sliders, &setup, bar, slack);
                 (moved, points)
             };
-            let one = repaired(repair_in_batches::<1>);
+            let one = repaired(repair_jointly::<1>);
             let batched: [(usize, Repair); 3] = [
-                (2, repair_in_batches::<2>),
-                (5, repair_in_batches::<5>),
-                (64, repair_in_batches::<64>),
+                (2, repair_jointly::<2>),
+                (5, repair_jointly::<5>),
+                (64, repair_jointly::<64>),
             ];
             for (batch, repair) in batched {
                 let many = repaired(repair);

@@ -660,7 +660,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             // see the module).
             let (around, fixed) = (vertex_quads(mesh), fixed_vertices(t, elements, mesh));
             let slack = energy_before - setup.energy(&mesh.vertices);
-            moved += joint::repair_jointly(
+            moved += joint::repair_jointly::<{ joint::BATCH }>(
                 &mut mesh.vertices,
                 &around,
                 &fixed,
@@ -700,6 +700,32 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         before,
         after,
     })
+}
+
+#[cfg(test)]
+impl<'a> Setup<'a> {
+    /// The tests' setup of `quads`: `metric` against a mean quad area of 1, quad `q` held to
+    /// quality `quality[q]`, shape `shape[q]` and scaled Jacobian `jacobian[q]`, one sweep of
+    /// one Powell iteration per solve.
+    pub(crate) fn held(
+        quads: &'a [[u32; 4]],
+        metric: Metric,
+        [quality, shape, jacobian]: [&'a [f64]; 3],
+    ) -> Self {
+        Setup {
+            quads,
+            metric,
+            average_area: 1.0,
+            quality_floors: quality,
+            shape_floors: shape,
+            jacobian_floors: jacobian,
+            max_sweeps: 1,
+            tolerance: 0.0,
+            local_iterations: 1,
+            local_solver: LocalSolver::Powell,
+            settled_term: 0.0,
+        }
+    }
 }
 
 /// The boundary graphs of label grids that imesh-curves' tests build.
@@ -763,19 +789,11 @@ mod tests {
 
     /// A setup of one quad with no floors.
     fn unit_setup() -> Setup<'static> {
-        Setup {
-            quads: &[[0, 1, 2, 3]],
-            metric: Metric::ShapeAndSize,
-            average_area: 1.0,
-            quality_floors: &[0.0],
-            shape_floors: &[0.0],
-            jacobian_floors: &[f64::NEG_INFINITY],
-            max_sweeps: 1,
-            tolerance: 0.0,
-            local_iterations: 1,
-            local_solver: LocalSolver::Powell,
-            settled_term: 0.0,
-        }
+        Setup::held(
+            &[[0, 1, 2, 3]],
+            Metric::ShapeAndSize,
+            [&[0.0], &[0.0], &[f64::NEG_INFINITY]],
+        )
     }
 
     /// Two or four coincident corners make a corner's shape 0/0: the quad's shape is still 0,

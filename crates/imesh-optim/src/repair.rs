@@ -434,7 +434,7 @@ mod tests {
         compass, corners_value, corners_value_above, stalling_grid, Unchanged, NEVER, REPAIR_FLOOR,
         REPAIR_JACOBIAN,
     };
-    use crate::{LocalSolver, Metric, Setup};
+    use crate::{Metric, Setup};
     use imesh_geom::Point;
     use proptest::prelude::*;
 
@@ -456,19 +456,7 @@ mod tests {
                 .collect();
             let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
             let floors = [0.2, 0.0, 0.1, 0.0];
-            let setup = Setup {
-                quads: &quads,
-                metric: Metric::Shape,
-                average_area: 1.0,
-                quality_floors: &[0.0; 4],
-                shape_floors: &floors,
-                jacobian_floors: &floors,
-                max_sweeps: 1,
-                tolerance: 0.0,
-                local_iterations: 1,
-                local_solver: LocalSolver::Powell,
-                settled_term: 0.0,
-            };
+            let setup = Setup::held(&quads, Metric::Shape, [&[0.0; 4], &floors, &floors]);
             let all = [0, 1, 2, 3];
             let value = corners_value(&all, &vertices, &setup, REPAIR_JACOBIAN);
             // Or the same smallest scaled Jacobian as the value, and either shape; or the value.
@@ -533,19 +521,11 @@ mod tests {
             floors(imesh_quality::quad::shape),
             floors(imesh_quality::quad::scaled_jacobian),
         );
-        let setup = Setup {
-            quads: &quads,
-            metric: Metric::Shape,
-            average_area: 1.0,
-            quality_floors: &[0.0; 4],
-            shape_floors: &shape_floors,
-            jacobian_floors: &jacobian_floors,
-            max_sweeps: 1,
-            tolerance: 0.0,
-            local_iterations: 1,
-            local_solver: LocalSolver::Powell,
-            settled_term: 0.0,
-        };
+        let setup = Setup::held(
+            &quads,
+            Metric::Shape,
+            [&[0.0; 4], &shape_floors, &jacobian_floors],
+        );
         let free = [4usize, 5];
         let quads_of = |v: usize| -> Vec<u32> {
             (0..4u32)
