@@ -7,6 +7,8 @@
 //! searches in order, those that can run now; each runs over its own copy of its points
 //! ([`Subproblem`]), and the caller keeps the moves in order.
 
+use std::collections::VecDeque;
+
 use imesh_geom::Point;
 
 use crate::Setup;
@@ -112,7 +114,7 @@ impl Scheduler {
     /// dropped. `queue` keeps the searches left, in order.
     pub fn take<T>(
         &mut self,
-        queue: &mut Vec<T>,
+        queue: &mut VecDeque<T>,
         most: usize,
         reads: impl Fn(&T, &mut Vec<u32>),
         moves: impl Fn(&T, &mut Vec<u32>),
@@ -121,12 +123,13 @@ impl Scheduler {
         self.stamp += 1;
         let stamp = self.stamp;
         let mut now = Vec::new();
-        let mut left = Vec::new();
-        for task in queue.drain(..) {
-            if now.len() == most || (!self.ahead && !left.is_empty()) {
-                left.push(task);
-                continue;
-            }
+        // Those that wait, in order; they go back to the front of the queue, the searches not
+        // looked at staying where they are.
+        let mut waiting = Vec::new();
+        while now.len() < most && (self.ahead || waiting.is_empty()) {
+            let Some(task) = queue.pop_front() else {
+                break;
+            };
             self.scratch.clear();
             reads(&task, &mut self.scratch);
             // What it moves is among what it reads: one test covers both directions.
@@ -138,7 +141,7 @@ impl Scheduler {
                 for &v in &self.scratch {
                     self.waiting[v as usize] = stamp;
                 }
-                left.push(task);
+                waiting.push(task);
             } else if !idle(&task) {
                 self.scratch.clear();
                 moves(&task, &mut self.scratch);
@@ -148,7 +151,9 @@ impl Scheduler {
                 now.push(task);
             }
         }
-        *queue = left;
+        for task in waiting.into_iter().rev() {
+            queue.push_front(task);
+        }
         now
     }
 }
@@ -159,6 +164,7 @@ mod tests {
     use crate::{Metric, Setup};
     use imesh_geom::Point;
     use proptest::prelude::*;
+    use std::collections::VecDeque;
 
     /// Three quads picked out of a row of five, out of order: over their own points they
     /// score as they do in the mesh, each with its own floors, and every corner maps back.
@@ -271,7 +277,7 @@ mod tests {
             }
             let mut state = start;
             let mut scheduler = if ahead { Scheduler::new(24) } else { Scheduler::in_order(24) };
-            let mut queue = searches.clone();
+            let mut queue: VecDeque<Search> = searches.iter().cloned().collect();
             let mut rounds = 0;
             while !queue.is_empty() {
                 let now = scheduler.take(

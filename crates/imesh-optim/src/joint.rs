@@ -18,6 +18,8 @@
 //! power 1 spreads the gain and left most worst quads where they were; 8 gave astronaut
 //! 0.490 → 0.427).
 
+use std::collections::VecDeque;
+
 use imesh_geom::Point;
 use rayon::prelude::*;
 
@@ -140,7 +142,7 @@ fn run<const B: usize>(
     mut slack: f64,
 ) -> (usize, Vec<(usize, f64, bool)>) {
     let setup = context.setup;
-    let mut queue: Vec<usize> = (0..candidates.len()).collect();
+    let mut queue: VecDeque<usize> = (0..candidates.len()).collect();
     let mut moved = 0;
     let mut log = Vec::new();
     while !queue.is_empty() {

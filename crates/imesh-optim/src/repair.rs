@@ -12,6 +12,8 @@
 use imesh_geom::{Point, Triangulation};
 use imesh_quad::{ElementMesh, QuadMesh};
 
+use std::collections::VecDeque;
+
 use rayon::prelude::*;
 
 use crate::batches::{Scheduler, Subproblem};
@@ -118,7 +120,7 @@ pub(crate) fn repair(
             }
         }
         let mut any = false;
-        let mut queue: Vec<usize> = (0..vars.len()).filter(|&i| wanted[i]).collect();
+        let mut queue: VecDeque<usize> = (0..vars.len()).filter(|&i| wanted[i]).collect();
         while !queue.is_empty() {
             let now = scheduler.take(
                 &mut queue,
@@ -159,7 +161,7 @@ pub(crate) fn repair(
     for _ in 0..PASSES {
         let mut any = false;
         // Each poor quad with two free corners or more: those corners, and their quads.
-        let mut queue: Vec<(u32, Vec<u32>, Vec<u32>)> = poor(vertices)
+        let mut queue: VecDeque<(u32, Vec<u32>, Vec<u32>)> = poor(vertices)
             .into_iter()
             .filter_map(|q| {
                 let free: Vec<u32> = setup.quads[q as usize]
