@@ -18,7 +18,9 @@
 //! time by [`Powell`]'s method, points coloured so that one colour shares no quad and is solved
 //! in parallel; [`Method::Global`] is the paper's single Powell run over all variables;
 //! [`Method::Laplacian`] and [`Method::Vertex`] are baselines that move the quad vertices
-//! directly.
+//! directly. The repairs after the descent ([`OptimOptions::repair`]) are runs of small
+//! searches, each seeing the moves before it; they run side by side wherever neither of two
+//! reads what the other moves, kept in order, so they end where one after the other would.
 //!
 //! ```
 //! use imesh_curves::{fit_edges, simplify, CurveGraph, FitOptions, GraphEdge, SimplifyOptions};
