@@ -37,10 +37,8 @@ const FIRST_STEP: f64 = 0.05;
 /// A slider stays this share of its starting gap away from either neighbour on its chain.
 const MARGIN: f64 = 0.05;
 
-/// Most patches solved side by side: the poor quads are taken in order, up to the first whose
-/// patch reads a point that an earlier one may move ([`Scheduler::in_order`]), solved in
-/// parallel and kept or dropped in order, so the result is that of solving them one after the
-/// other. A constant, not the thread count, so that the batches depend on nothing else.
+/// Most patches solved side by side ([`repair_jointly`]). A constant, not the thread count, so
+/// that the batches depend on nothing else.
 pub(crate) const BATCH: usize = 32;
 
 /// One moving point of a patch; `at` is its index among the patch's points.

@@ -266,8 +266,8 @@ impl Unchanged {
     }
 }
 
-/// Searches side by side at most ([`Scheduler::take`]): enough to keep two or more threads busy,
-/// few enough that a batch's later searches seldom wait on its earlier ones.
+/// Searches side by side at most ([`Scheduler::take`]): enough to keep a few threads busy; a
+/// constant, not the thread count, so that the batches depend on nothing else.
 const BATCH: usize = 64;
 
 /// The corners of `quads` (of `setup`) into `out`.
