@@ -99,9 +99,15 @@ pub(crate) fn repair(
     let mut moved = vec![false; vars.len()];
     // A search is a function of the corners of the quads it scores: one that found no move is
     // not run again until one of those corners has moved (the same result, unsearched).
-    let mut since = Unchanged::new(vertices.len());
-    let mut scheduler = Scheduler::new(vertices.len());
+    let mut searcher = Searcher {
+        since: Unchanged::new(vertices.len()),
+        scheduler: Scheduler::new(vertices.len()),
+    };
     let mut vertex_failed = vec![NEVER; vars.len()];
+    let mut variable_of = vec![u32::MAX; vertices.len()];
+    for (i, &v) in vars.ids.iter().enumerate() {
+        variable_of[v as usize] = i as u32;
+    }
     let mut poor_quads = first;
     for pass in 0..PASSES {
         if pass > 0 {
@@ -119,33 +125,17 @@ pub(crate) fn repair(
                 }
             }
         }
-        let mut any = false;
-        let mut queue: VecDeque<usize> = (0..vars.len()).filter(|&i| wanted[i]).collect();
-        while !queue.is_empty() {
-            let now = scheduler.take(
-                &mut queue,
-                BATCH,
-                |&i, reads| corners(vars.quads.row(i), setup, reads),
-                |&i, moves| moves.push(vars.ids[i]),
-                |&i| since.unchanged(vertex_failed[i], vars.quads.row(i), setup.quads),
-            );
-            let view = &*vertices;
-            let found: Vec<Option<Vec<Point>>> = now
-                .par_iter()
-                .map(|&i| search(&[vars.ids[i]], &[1], vars.quads.row(i), view, setup, bar))
-                .collect();
-            for (&i, found) in now.iter().zip(found) {
-                if let Some(found) = found {
-                    vertices[vars.ids[i] as usize] = found[0];
-                    moved[i] = true;
-                    any = true;
-                    since.moved(&[vars.ids[i]]);
-                } else {
-                    vertex_failed[i] = since.now();
-                }
-            }
+        let searches = (0..vars.len()).filter(|&i| wanted[i]).map(|i| Search {
+            slot: i,
+            moving: std::slice::from_ref(&vars.ids[i]),
+            quads: vars.quads.row(i),
+            together: 1,
+        });
+        let found = searcher.run(searches.collect(), &mut vertex_failed, vertices, setup, bar);
+        for &v in &found {
+            moved[variable_of[v as usize] as usize] = true;
         }
-        if !any {
+        if found.is_empty() {
             break;
         }
     }
@@ -153,15 +143,10 @@ pub(crate) fn repair(
     // of its free corners to move at once: one alone turns the pinned corner but bends the quad
     // at the other (measured: coffee's worst scaled Jacobian 0.396 → 0.420, the other eight
     // fixtures' equal).
-    let mut variable_of = vec![u32::MAX; vertices.len()];
-    for (i, &v) in vars.ids.iter().enumerate() {
-        variable_of[v as usize] = i as u32;
-    }
     let mut quad_failed = vec![NEVER; setup.quads.len()];
     for _ in 0..PASSES {
-        let mut any = false;
         // Each poor quad with two free corners or more: those corners, and their quads.
-        let mut queue: VecDeque<(u32, Vec<u32>, Vec<u32>)> = poor(vertices)
+        let corners: Vec<(usize, Vec<u32>, Vec<u32>)> = poor(vertices)
             .into_iter()
             .filter_map(|q| {
                 let free: Vec<u32> = setup.quads[q as usize]
@@ -182,41 +167,20 @@ pub(crate) fn repair(
                     .collect();
                 quads.sort_unstable();
                 quads.dedup();
-                Some((q, free, quads))
+                Some((q as usize, free, quads))
             })
             .collect();
-        while !queue.is_empty() {
-            let now = scheduler.take(
-                &mut queue,
-                BATCH,
-                |(_, _, quads), reads| corners(quads, setup, reads),
-                |(_, free, _), moves| moves.extend_from_slice(free),
-                |(q, _, quads)| since.unchanged(quad_failed[*q as usize], quads, setup.quads),
-            );
-            let view = &*vertices;
-            let found: Vec<Option<Vec<Point>>> = now
-                .par_iter()
-                .map(|(_, free, quads)| {
-                    let together: Vec<u32> = (1..1u32 << free.len())
-                        .filter(|m| m.count_ones() >= 2)
-                        .collect();
-                    search(free, &together, quads, view, setup, bar)
-                })
-                .collect();
-            for ((q, free, _), found) in now.iter().zip(found) {
-                if let Some(found) = found {
-                    for (&v, &p) in free.iter().zip(&found) {
-                        vertices[v as usize] = p;
-                        moved[variable_of[v as usize] as usize] = true;
-                    }
-                    any = true;
-                    since.moved(free);
-                } else {
-                    quad_failed[*q as usize] = since.now();
-                }
-            }
+        let searches = corners.iter().map(|(q, free, quads)| Search {
+            slot: *q,
+            moving: free,
+            quads,
+            together: 2,
+        });
+        let found = searcher.run(searches.collect(), &mut quad_failed, vertices, setup, bar);
+        for &v in &found {
+            moved[variable_of[v as usize] as usize] = true;
         }
-        if !any {
+        if found.is_empty() {
             break;
         }
     }
@@ -275,21 +239,74 @@ fn corners(quads: &[u32], setup: &Setup, out: &mut Vec<u32>) {
     out.extend(quads.iter().flat_map(|&q| setup.quads[q as usize]));
 }
 
-/// [`compass`] over a copy of the corners of `quads`: where `moving` went, if one moved.
-fn search(
-    moving: &[u32],
-    groups: &[u32],
-    quads: &[u32],
-    vertices: &[Point],
-    setup: &Setup,
-    bar: f64,
-) -> Option<Vec<Point>> {
-    let sub = Subproblem::new(quads, setup);
-    let mut points = sub.gather(vertices);
-    let moving: Vec<usize> = moving.iter().filter_map(|&v| sub.index(v)).collect();
-    let all: Vec<u32> = (0..sub.len() as u32).collect();
-    compass(&moving, groups, &all, &mut points, &sub.setup(setup), bar)
-        .then(|| moving.iter().map(|&k| points[k]).collect())
+/// One compass search of the repair: vertices `moving`, any `together` or more of them stepping
+/// together, raising the corners of `quads` (all the quads they are corners of); `slot` is
+/// where its last failure is kept.
+struct Search<'a> {
+    slot: usize,
+    moving: &'a [u32],
+    quads: &'a [u32],
+    together: u32,
+}
+
+/// What runs the repair's searches: the clock of the vertices' moves, and the scheduler.
+struct Searcher {
+    since: Unchanged,
+    scheduler: Scheduler,
+}
+
+impl Searcher {
+    /// Runs `searches` in order, side by side where neither reads what the other moves; one
+    /// whose quads' corners have not moved since it last found no move (at `failed[slot]`) is
+    /// not run again. Returns the vertices moved, in the order of their searches.
+    fn run(
+        &mut self,
+        mut queue: VecDeque<Search>,
+        failed: &mut [u32],
+        vertices: &mut [Point],
+        setup: &Setup,
+        bar: f64,
+    ) -> Vec<u32> {
+        let mut moved = Vec::new();
+        while !queue.is_empty() {
+            let since = &self.since;
+            let now = self.scheduler.take(
+                &mut queue,
+                BATCH,
+                |s, reads| corners(s.quads, setup, reads),
+                |s, moves| moves.extend_from_slice(s.moving),
+                |s| since.unchanged(failed[s.slot], s.quads, setup.quads),
+            );
+            let view = &*vertices;
+            let found: Vec<Option<Vec<Point>>> = now
+                .par_iter()
+                .map(|s| {
+                    let groups: Vec<u32> = (1..1u32 << s.moving.len())
+                        .filter(|m| m.count_ones() >= s.together)
+                        .collect();
+                    let sub = Subproblem::new(s.quads, setup);
+                    let mut points = sub.gather(view);
+                    let moving: Vec<usize> =
+                        s.moving.iter().filter_map(|&v| sub.index(v)).collect();
+                    let all: Vec<u32> = (0..sub.len() as u32).collect();
+                    compass(&moving, &groups, &all, &mut points, &sub.setup(setup), bar)
+                        .then(|| moving.iter().map(|&k| points[k]).collect())
+                })
+                .collect();
+            for (s, found) in now.iter().zip(found) {
+                if let Some(found) = found {
+                    for (&v, &p) in s.moving.iter().zip(&found) {
+                        vertices[v as usize] = p;
+                    }
+                    moved.extend_from_slice(s.moving);
+                    self.since.moved(s.moving);
+                } else {
+                    failed[s.slot] = self.since.now();
+                }
+            }
+        }
+        moved
+    }
 }
 
 /// Compass search moving the vertices `moving` (each `groups` mask a set of them stepping
