@@ -33,8 +33,12 @@ pub const REPAIR_JACOBIAN: f64 = 0.5;
 /// worst shape 0.318 → 0.329; at 0.4, 0.421 and 0.320.
 pub const REPAIR_FLOOR: f64 = 0.45;
 
-/// Most passes over the vertices near poor quads (each pass finds them again).
-const PASSES: usize = 4;
+/// Most passes over the vertices near poor quads (each pass finds them again; the passes stop
+/// at one that moves nothing). Measured with the defaults on fourteen images against 4 (with
+/// the joint repair's passes): worst shape brick 0.462 → 0.500, coffee 0.431 → 0.430, the
+/// other twelve equal, mean shape-and-size within 0.00002; optimiser time +1 % to +9 % at the
+/// default size and −3 % to +14 % graded (interleaved runs; no graded worst value moved).
+const PASSES: usize = 8;
 
 /// Compass directions: the axes, then the diagonals.
 const DIRECTIONS: [(f64, f64); 8] = [
