@@ -682,7 +682,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                 joint::Budget {
                     slack,
                     passes: options.joint_passes,
-                    anew: false,
+                    later: joint::LATER_PASS_QUADS,
                 },
             );
             // Repair trades energy for corners; it never takes back more than the descent gained
