@@ -24,7 +24,7 @@ use imesh_geom::Point;
 use rayon::prelude::*;
 
 use crate::batches::{Scheduler, Subproblem};
-use crate::repair::{corners_value, REPAIR_FLOOR};
+use crate::repair::{corners_value, held_at};
 use crate::slide::Sliders;
 use crate::variables::Rows;
 use crate::{Powell, Setup};
@@ -81,7 +81,7 @@ enum Along {
 /// Up to `budget.passes` passes: a patch is solved with its neighbours where the patches before
 /// it left them, and once they have moved on it may reach further. A pass after the first
 /// takes the `budget.later` poorest quads the last left under the bar, each quad held to
-/// where the last pass left it too (up to [`REPAIR_FLOOR`]); the passes stop at one that keeps
+/// where the last pass left it too (up to [`REPAIR_FLOOR`](crate::REPAIR_FLOOR)); the passes stop at one that keeps
 /// no patch or leaves the worst shape where it was.
 ///
 /// Within a pass, a patch is solved ahead of earlier ones that must wait ([`Scheduler::new`])
@@ -150,16 +150,15 @@ pub(crate) fn repair_jointly<const B: usize>(
     moved
 }
 
-/// Raises each quad's floors to where it is now, up to [`REPAIR_FLOOR`].
+/// Raises each quad's floors to where it is now, up to [`REPAIR_FLOOR`](crate::REPAIR_FLOOR).
 fn raise_floors(points: &[Point], setup: &Setup, shape: &mut [f64], jacobian: &mut [f64]) {
     shape
         .par_iter_mut()
         .zip(jacobian.par_iter_mut())
         .enumerate()
         .for_each(|(q, (shape, jacobian))| {
-            let p = setup.quads[q].map(|v| [points[v as usize].x, points[v as usize].y]);
-            *shape = shape.max(imesh_quality::quad::shape(&p).min(REPAIR_FLOOR));
-            *jacobian = jacobian.max(imesh_quality::quad::scaled_jacobian(&p).min(REPAIR_FLOOR));
+            let [now_shape, now_jacobian] = held_at(points, &setup.quads[q]);
+            (*shape, *jacobian) = (shape.max(now_shape), jacobian.max(now_jacobian));
         });
 }
 

@@ -637,14 +637,10 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             let (shape_now, jacobian_now): (Vec<f64>, Vec<f64>) = quads
                 .par_iter()
                 .map(|q| {
-                    let p = q.map(|v| [mesh.vertices[v as usize].x, mesh.vertices[v as usize].y]);
+                    let [shape, jacobian] = repair::held_at(&mesh.vertices, q);
                     (
-                        imesh_quality::quad::shape(&p)
-                            .min(REPAIR_FLOOR)
-                            .max(before.shape.min),
-                        imesh_quality::quad::scaled_jacobian(&p)
-                            .min(REPAIR_FLOOR)
-                            .max(before.scaled_jacobian.min),
+                        shape.max(before.shape.min),
+                        jacobian.max(before.scaled_jacobian.min),
                     )
                 })
                 .unzip();

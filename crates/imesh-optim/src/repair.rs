@@ -33,6 +33,16 @@ pub const REPAIR_JACOBIAN: f64 = 0.5;
 /// worst shape 0.318 → 0.329; at 0.4, 0.421 and 0.320.
 pub const REPAIR_FLOOR: f64 = 0.45;
 
+/// Where the repair may lower `quad` of `points` to, at most: its shape and scaled Jacobian,
+/// each capped at [`REPAIR_FLOOR`].
+pub(crate) fn held_at(points: &[Point], quad: &[u32; 4]) -> [f64; 2] {
+    let p = quad.map(|v| [points[v as usize].x, points[v as usize].y]);
+    [
+        imesh_quality::quad::shape(&p).min(REPAIR_FLOOR),
+        imesh_quality::quad::scaled_jacobian(&p).min(REPAIR_FLOOR),
+    ]
+}
+
 /// Most passes over the vertices near poor quads (each pass finds them again; the passes stop
 /// at one that moves nothing). Measured with the defaults on fourteen images against 4 (with
 /// the joint repair's passes): worst shape brick 0.462 → 0.500, coffee 0.431 → 0.430, the
