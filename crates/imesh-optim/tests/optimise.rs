@@ -298,14 +298,20 @@ fn the_control_points_follow_the_quad_vertices() {
     }
 }
 
+/// A copy of `start` optimised with `options`, and the report.
+fn optimised(start: &Remesh, options: &OptimOptions) -> (Remesh, OptimReport) {
+    let mut r = start.clone();
+    let report = optimise(&mut r, options).unwrap();
+    (r, report)
+}
+
 /// Stardist's quad mesh, optimised by the local mode with every promise checked (`check`), and
 /// again with `off` (the defaults with one step turned off): the start and both results.
 fn with_and_without(off: OptimOptions) -> (Remesh, (Remesh, OptimReport), (Remesh, OptimReport)) {
     let start = quad_mesh(&support::fixture("stardist-mask2d_labels.png"));
     let with = check(&start, Method::Local, Metric::ShapeAndSize);
-    let mut r = start.clone();
-    let report = optimise(&mut r, &off).unwrap();
-    (start, with, (r, report))
+    let without = optimised(&start, &off);
+    (start, with, without)
 }
 
 /// Sliding the boundary vertices along their curves (checked by `check`: they stay on them)
@@ -376,17 +382,12 @@ fn settled_points_are_not_solved() {
     options.density.spacing = Some(4.0);
     let start = remesh(&s.graph, &curves, &options).unwrap();
     let run = |settled: f64| {
-        let mut r = start.clone();
-        let report = optimise(
-            &mut r,
-            &OptimOptions {
-                settled,
-                repair: false,
-                ..OptimOptions::default()
-            },
-        )
-        .unwrap();
-        (r, report)
+        let options = OptimOptions {
+            settled,
+            repair: false,
+            ..OptimOptions::default()
+        };
+        optimised(&start, &options)
     };
     let (every, full) = run(1.0);
     let (some, default) = run(OptimOptions::default().settled);
@@ -457,16 +458,11 @@ fn repair_raises_the_worst_corners() {
 fn later_joint_passes_keep_what_the_first_gave() {
     let start = quad_mesh(&support::fixture("skimage-coins.png"));
     let run = |joint_passes: usize| {
-        let mut r = start.clone();
-        let report = optimise(
-            &mut r,
-            &OptimOptions {
-                joint_passes,
-                ..OptimOptions::default()
-            },
-        )
-        .unwrap();
-        (r, report)
+        let options = OptimOptions {
+            joint_passes,
+            ..OptimOptions::default()
+        };
+        optimised(&start, &options)
     };
     let ((one, once), (three, thrice)) = (run(1), run(3));
     assert!(
@@ -523,17 +519,13 @@ fn good_quads_stay_good() {
     let start = remesh(&s.graph, &curves, &options).unwrap();
     let average = start.mesh.area() / start.mesh.quads.len() as f64;
     let run = |keep_quality: f64| {
-        let mut r = start.clone();
         // The repair may trade sizes for corners: without it the floors hold to the end.
-        let report = optimise(
-            &mut r,
-            &OptimOptions {
-                keep_quality,
-                repair: false,
-                ..OptimOptions::default()
-            },
-        )
-        .unwrap();
+        let options = OptimOptions {
+            keep_quality,
+            repair: false,
+            ..OptimOptions::default()
+        };
+        let (r, report) = optimised(&start, &options);
         (report, shape_and_size(&r, average))
     };
     let before = shape_and_size(&start, average);
