@@ -38,9 +38,9 @@ const FIRST_STEP: f64 = 0.05;
 const MARGIN: f64 = 0.05;
 
 /// The poor quads a pass after the first solves in the optimiser ([`Budget::later`]): the
-/// poorest only. Later passes are for the
-/// worst quads, and a graded mesh leaves thousands under the bar, whose second pass took as
-/// long as the first for nothing (graded MRI and brick: optimiser time +46 % and +38 %).
+/// poorest only. Later passes are for the worst quads, and a graded mesh leaves thousands
+/// under the bar, whose second pass took as long as the first for nothing (graded MRI and
+/// brick: optimiser time +46 % and +38 %).
 pub(crate) const LATER_PASS_QUADS: usize = 64;
 
 /// Most patches solved side by side ([`repair_jointly`]). A constant, not the thread count, so
@@ -81,8 +81,8 @@ enum Along {
 /// Up to `budget.passes` passes: a patch is solved with its neighbours where the patches before
 /// it left them, and once they have moved on it may reach further. A pass after the first
 /// takes the `budget.later` poorest quads the last left under the bar, each quad held to
-/// where the last pass left it too (up to [`REPAIR_FLOOR`](crate::REPAIR_FLOOR)); the passes stop at one that keeps
-/// no patch or leaves the worst shape where it was.
+/// where the last pass left it too (up to [`REPAIR_FLOOR`](crate::REPAIR_FLOOR)); the passes
+/// stop at one that keeps no patch or leaves the worst shape where it was.
 ///
 /// Within a pass, a patch is solved ahead of earlier ones that must wait ([`Scheduler::new`])
 /// where neither reads what the other moves, and its moves are kept or dropped as it comes: the
@@ -753,7 +753,8 @@ mod tests {
         assert!((0..9).all(|v| !fixed[v] || points[v] == before[v]));
     }
 
-    /// A strip of 40 × 6 points, its border fixed, its inside jittered by up to 0.35.
+    /// A strip of 40 × 6 points, its border fixed, its inside jittered by up to 0.35, its rows
+    /// [`Strip::SQUEEZE`] apart (flat quads: many under the bar, their patches overlapping).
     struct Strip {
         fixed: Vec<bool>,
         before: Vec<Point>,
@@ -761,10 +762,10 @@ mod tests {
         around: Rows<u32>,
     }
 
-    const SQUEEZE: f64 = 0.4;
     impl Strip {
         const W: u32 = 40;
         const H: u32 = 6;
+        const SQUEEZE: f64 = 0.4;
 
         fn new(jitter: &[(f64, f64)]) -> Self {
             let (w, h) = (Self::W, Self::H);
@@ -779,7 +780,10 @@ mod tests {
                     } else {
                         (0.0, 0.0)
                     };
-                    Point::new(f64::from(k % w) + dx, SQUEEZE * (f64::from(k / w) + dy))
+                    Point::new(
+                        f64::from(k % w) + dx,
+                        Self::SQUEEZE * (f64::from(k / w) + dy),
+                    )
                 })
                 .collect();
             let quads = rectangle_quads(w, h);

@@ -175,12 +175,12 @@ pub struct OptimOptions {
     /// then, for each quad still under it, every free vertex and boundary vertex of the quads
     /// around its corners in one [`Powell`] run (`joint.rs`), pass after pass
     /// ([`OptimOptions::joint_passes`]); undone if it would leave the energy above the start's.
-    /// The energy leaves such quads where their shape-and-size is fair. Measured with the defaults (a bar of 0.4 and the
-    /// descent's floors then): worst scaled Jacobian stardist 0.272 → 0.355, coffee
-    /// 0.251 → 0.280, grass 0.280 → 0.299, MRI 0.352 → 0.371, camera 0.358 → 0.383; worst shape
-    /// stardist 0.232 → 0.312, coffee 0.192 → 0.224, grass 0.068 → 0.119, gravel 0.075 →
-    /// 0.155; the other values equal; mean shape-and-size within 0.001; 0.5–4 % of the
-    /// optimiser's time.
+    /// The energy leaves such quads where their shape-and-size is fair. Measured with the
+    /// defaults (a bar of 0.4 and the descent's floors then): worst scaled Jacobian stardist
+    /// 0.272 → 0.355, coffee 0.251 → 0.280, grass 0.280 → 0.299, MRI 0.352 → 0.371, camera
+    /// 0.358 → 0.383; worst shape stardist 0.232 → 0.312, coffee 0.192 → 0.224, grass 0.068 →
+    /// 0.119, gravel 0.075 → 0.155; the other values equal; mean shape-and-size within 0.001;
+    /// 0.5–4 % of the optimiser's time.
     pub repair: bool,
     /// Most passes of the repair's last step (`joint.rs`: each quad still under the bar with
     /// its neighbourhood moved at once). A patch is solved with its neighbours where the

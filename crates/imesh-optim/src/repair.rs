@@ -33,8 +33,8 @@ pub const REPAIR_JACOBIAN: f64 = 0.5;
 /// worst shape 0.318 → 0.329; at 0.4, 0.421 and 0.320.
 pub const REPAIR_FLOOR: f64 = 0.45;
 
-/// Where the repair may lower `quad` of `points` to, at most: its shape and scaled Jacobian,
-/// each capped at [`REPAIR_FLOOR`].
+/// The floors the repair holds `quad` of `points` to from where it stands: its shape and its
+/// scaled Jacobian now, each capped at [`REPAIR_FLOOR`].
 pub(crate) fn held_at(points: &[Point], quad: &[u32; 4]) -> [f64; 2] {
     let p = quad.map(|v| [points[v as usize].x, points[v as usize].y]);
     [
