@@ -36,10 +36,15 @@ pub const REPAIR_FLOOR: f64 = 0.45;
 /// The floors the repair holds `quad` of `points` to from where it stands: its shape and its
 /// scaled Jacobian now, each capped at [`REPAIR_FLOOR`].
 pub(crate) fn held_at(points: &[Point], quad: &[u32; 4]) -> [f64; 2] {
+    held_up_to(points, quad, REPAIR_FLOOR)
+}
+
+/// The shape and the scaled Jacobian of `quad` of `points`, each capped at `cap`.
+pub(crate) fn held_up_to(points: &[Point], quad: &[u32; 4], cap: f64) -> [f64; 2] {
     let p = quad.map(|v| [points[v as usize].x, points[v as usize].y]);
     [
-        imesh_quality::quad::shape(&p).min(REPAIR_FLOOR),
-        imesh_quality::quad::scaled_jacobian(&p).min(REPAIR_FLOOR),
+        imesh_quality::quad::shape(&p).min(cap),
+        imesh_quality::quad::scaled_jacobian(&p).min(cap),
     ]
 }
 

@@ -606,6 +606,8 @@ pub struct Optimisation {
     pub repaired: usize,
     /// ... of which boundary vertices moved along their curves.
     pub repaired_sliders: usize,
+    /// Patches moved last for the quality of their poorest quads.
+    pub quality_repaired: usize,
 }
 
 /// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
@@ -1601,6 +1603,7 @@ impl Pipeline {
                 sliders: optimisation.sliders,
                 repaired: optimisation.repaired,
                 repaired_sliders: optimisation.repaired_sliders,
+                quality_repaired: optimisation.quality_repaired,
             },
             before: optimisation.before,
             histograms: QualityHistograms {
