@@ -30,6 +30,8 @@ struct Row {
     scaled_jacobian: [f64; 2],
     label_agreement: f64,
     unpaired_share: f64,
+    /// Quads whose shape-and-size is under the paper's worst value (0.25, issue 8's target).
+    poor_quads: usize,
 }
 
 #[derive(Serialize)]
@@ -123,7 +125,22 @@ fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Re
         scaled_jacobian: [q.scaled_jacobian().min, q.scaled_jacobian().mean],
         label_agreement: r.label_agreement,
         unpaired_share: r.counts.unpaired_triangles as f64 / r.counts.dt_triangles.max(1) as f64,
+        poor_quads: under_a_quarter(
+            &r.histograms
+                .as_ref()
+                .ok_or("no quality histograms")?
+                .shape_and_size_after,
+        )?,
     })
+}
+
+/// The values under 0.25 in `histogram`, which must be the report's twenty bins over [0, 1]:
+/// its first five.
+fn under_a_quarter(histogram: &imesh_quality::Histogram) -> Result<usize, String> {
+    if histogram.counts.len() != 20 || histogram.lo != 0.0 || histogram.hi != 1.0 {
+        return Err("the shape-and-size histogram is not 20 bins over [0, 1]".into());
+    }
+    Ok(histogram.counts[..5].iter().sum())
 }
 
 fn tempdir() -> Result<PathBuf, String> {
@@ -132,12 +149,12 @@ fn tempdir() -> Result<PathBuf, String> {
     Ok(dir)
 }
 
-const HEADER: &str = "| image | size | vertices | quads | classify | sample | curves | DT' | pairing + templates | adaptation | optimisation | write | total s | S&S worst / mean / var | shape worst / mean | SJ worst / mean | label agreement | unpaired |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+const HEADER: &str = "| image | size | vertices | quads | classify | sample | curves | DT' | pairing + templates | adaptation | optimisation | write | total s | S&S worst / mean / var | S&S < 0.25 | shape worst / mean | SJ worst / mean | label agreement | unpaired |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 fn line(r: &Row) -> String {
     let s = &r.seconds;
     format!(
-        "| {} | {} × {}{} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} % | {:.1} % |",
+        "| {} | {} × {}{} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3} / {:.3} / {:.3} | {} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} % | {:.1} % |",
         r.name,
         r.width,
         r.height,
@@ -160,6 +177,7 @@ fn line(r: &Row) -> String {
         r.shape_and_size[0],
         r.shape_and_size[1],
         r.shape_and_size[2],
+        r.poor_quads,
         r.shape[0],
         r.shape[1],
         r.scaled_jacobian[0],
@@ -356,6 +374,16 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The count under 0.25 takes the values under it only, and wants the report's bins.
+    #[test]
+    fn quads_under_a_quarter_are_counted_from_the_histogram() {
+        let values = [0.0, 0.1, 0.2499, 0.25, 0.3, 0.9, 1.0];
+        let h = imesh_quality::Histogram::of(&values, 0.0, 1.0, 20);
+        assert_eq!(under_a_quarter(&h), Ok(3));
+        let other = imesh_quality::Histogram::of(&values, 0.0, 1.0, 10);
+        assert!(under_a_quarter(&other).is_err());
+    }
 
     #[test]
     fn the_readme_block_is_replaced_and_the_rest_kept() {

@@ -870,20 +870,8 @@ mod tests {
         let stalled = worst(&quads, &points, scaled_jacobian);
         assert!(stalled < REPAIR_JACOBIAN - 0.05, "{stalled}");
         let before = points.clone();
-        let moved = repair_jointly::<{ super::BATCH }>(
-            &mut points,
-            &around,
-            &fixed,
-            &mut Sliders::default(),
-            &setup,
-            Aim::Corners(REPAIR_JACOBIAN),
-            Budget {
-                slack: f64::INFINITY,
-                passes: 1,
-                first: usize::MAX,
-                later: 0,
-            },
-        );
+        let aim = Aim::Corners(REPAIR_JACOBIAN);
+        let moved = repair_once(&mut points, &around, &fixed, &setup, aim);
         let after = worst(&quads, &points, scaled_jacobian);
         assert!(moved > 0 && after > stalled + 0.05, "{stalled} → {after}");
         assert!((0..4).all(|q| setup
@@ -932,16 +920,7 @@ mod tests {
         assert!(worst(&quads, &before, shape) > REPAIR_JACOBIAN);
         let repaired = |aim: Aim| {
             let mut points = before.clone();
-            let budget = everything(1);
-            let moved = repair_jointly::<{ super::BATCH }>(
-                &mut points,
-                &around,
-                &fixed,
-                &mut Sliders::default(),
-                &setup,
-                aim,
-                budget,
-            );
+            let moved = repair_once(&mut points, &around, &fixed, &setup, aim);
             (moved, points)
         };
         assert_eq!(repaired(Aim::Corners(REPAIR_JACOBIAN)).0, 0);
@@ -1053,6 +1032,26 @@ mod tests {
                 budget,
             )
         }
+    }
+
+    /// One pass of the joint repair aimed at `aim`, with all the slack there is and no slider.
+    fn repair_once(
+        points: &mut [Point],
+        around: &Rows<u32>,
+        fixed: &[bool],
+        setup: &Setup,
+        aim: Aim,
+    ) -> usize {
+        let mut sliders = Sliders::default();
+        repair_jointly::<{ super::BATCH }>(
+            points,
+            around,
+            fixed,
+            &mut sliders,
+            setup,
+            aim,
+            everything(1),
+        )
     }
 
     /// `passes` passes with all the slack there is, later ones over the 64 poorest quads.
