@@ -191,9 +191,10 @@ impl Aim {
 ///
 /// Up to `budget.passes` passes: a patch is solved with its neighbours where the patches before
 /// it left them, and once they have moved on it may reach further. The first pass takes the
-/// `budget.first` poorest quads, a pass after it the `budget.later` poorest the last left poor, each quad held to
-/// where the last pass left it too (up to [`REPAIR_FLOOR`](crate::REPAIR_FLOOR)); the passes
-/// stop at one that keeps no patch or leaves the worst (by the aim's score) where it was.
+/// `budget.first` poorest quads, a pass after it the `budget.later` poorest the last left poor,
+/// each quad held to where the last pass left it too (up to
+/// [`REPAIR_FLOOR`](crate::REPAIR_FLOOR)); the passes stop at one that keeps no patch or leaves
+/// the worst (by the aim's score) where it was.
 ///
 /// Within a pass, a patch is solved ahead of earlier ones that must wait ([`Scheduler::new`])
 /// where neither reads what the other moves, and its moves are kept or dropped as it comes: the
@@ -664,10 +665,11 @@ fn clear_of_neighbours(movers: &[Mover], along: &[f64]) -> bool {
 }
 
 /// How far a patch's quads are under the bar: the Euclidean norms of their scaled Jacobians'
-/// and their shapes' shortfalls (the quads under `bar` only); infinite where a quad is invalid
-/// or under a floor, or a slider too close to a neighbour. The smallest alone leaves the line
-/// searches flat wherever two quads share it; the sum spreads the gain over many quads instead
-/// of raising the worst.
+/// and their shapes' shortfalls (the quads under `bar` only), or raising quality, the norm of
+/// their quality's shortfalls plus a share of their energy ([`Aim::combine`]); infinite where
+/// a quad is invalid or under a floor, or a slider too close to a neighbour. The smallest alone
+/// leaves the line searches flat wherever two quads share it; the sum spreads the gain over
+/// many quads instead of raising the worst.
 ///
 /// Kept quad by quad: most of Powell's line searches move one variable, hence one mover, and
 /// only the quads of the movers that moved since the last call are scored again. The sums run
@@ -675,8 +677,8 @@ fn clear_of_neighbours(movers: &[Mover], along: &[f64]) -> bool {
 struct Shortfall {
     /// Per mover, the quads it is a corner of.
     quads_of: Rows<u32>,
-    /// Per quad, its squared shortfalls (scaled Jacobian, shape; 0 at or over the bar), `None`
-    /// where it is invalid or under a floor.
+    /// Per quad, its terms ([`Aim::shortfalls`]: squared shortfalls, 0 at or over the bar),
+    /// `None` where it is invalid or under a floor.
     terms: Vec<Option<[f64; 2]>>,
     /// The variables of the last call (NaN before the first: every mover moves).
     last: Vec<f64>,
