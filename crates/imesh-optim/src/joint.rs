@@ -222,6 +222,15 @@ pub(crate) fn repair_jointly<const B: usize>(
         jacobian: setup.jacobian_floors.to_vec(),
     };
     for pass_index in 0..budget.passes {
+        // The scores read the points only, not the floors.
+        let mut poor: Vec<(f64, u32)> = (0..setup.quads.len() as u32)
+            .map(|q| (aim.score(setup, points, q as usize), q))
+            .filter(|&(s, _)| s < aim.poor())
+            .collect();
+        if pass_index == 0 && poor.len() > budget.graded {
+            break;
+        }
+        poor.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         if pass_index > 0 || matches!(aim, Aim::Quality { .. }) {
             floors.raise(points, setup, aim);
         }
@@ -237,11 +246,6 @@ pub(crate) fn repair_jointly<const B: usize>(
             slider_of: &slider_of,
             setup,
         };
-        let mut poor: Vec<(f64, u32)> = (0..setup.quads.len() as u32)
-            .map(|q| (aim.score(setup, points, q as usize), q))
-            .filter(|&(s, _)| s < aim.poor())
-            .collect();
-        poor.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         if pass_index > 0 {
             poor.truncate(budget.later);
         } else {
@@ -317,6 +321,10 @@ pub(crate) struct Budget {
     /// The most poor quads a pass after the first takes, the poorest ([`LATER_PASS_QUADS`] in
     /// the optimiser).
     pub later: usize,
+    /// With more poor quads than this at the start, none is repaired: the mesh is graded by
+    /// design, its poor quads many and small (all of them in the corners' repair;
+    /// [`crate::GRADED_SHARE`] of the quads when raising quality).
+    pub graded: usize,
 }
 
 /// One pass of [`repair_jointly`] over `candidates`: how many patches moved, and the energy
@@ -1063,6 +1071,7 @@ mod tests {
             passes,
             first: usize::MAX,
             later: 64,
+            graded: usize::MAX,
         }
     }
 
@@ -1146,7 +1155,7 @@ mod tests {
             let repaired = |slack: f64| {
                 let mut points = before.clone();
                 let mut sliders = Sliders::default();
-                repair_jointly::<{ super::BATCH }>(&mut points, &around, &fixed, &mut sliders, &setup, Aim::Corners(REPAIR_JACOBIAN), Budget { slack, passes: 3, first: usize::MAX, later: 64 });
+                repair_jointly::<{ super::BATCH }>(&mut points, &around, &fixed, &mut sliders, &setup, Aim::Corners(REPAIR_JACOBIAN), Budget { slack, passes: 3, first: usize::MAX, later: 64, graded: usize::MAX });
                 points
             };
             let start = worst(&quads, &points, scaled_jacobian).min(REPAIR_JACOBIAN);
@@ -1231,7 +1240,7 @@ mod tests {
             let setup = setup(&strip.quads, &floors, &none);
             let repaired = |batched: Repair| {
                 let mut points = strip.before.clone();
-                let budget = Budget { slack, passes: 3, first: usize::MAX, later };
+                let budget = Budget { slack, passes: 3, first: usize::MAX, later, graded: usize::MAX };
                 let moved = strip.repair(batched, &mut points, &setup, budget);
                 (moved, points)
             };

@@ -719,6 +719,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                     slack,
                     passes: options.joint_passes,
                     later: joint::LATER_PASS_QUADS,
+                    graded: usize::MAX,
                 },
             );
             // Last, with shape-and-size, the quads under POOR_QUALITY, each with its
@@ -726,14 +727,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             // area at a tip or in a strip, which the energy of all the quads leaves there. Not
             // on a graded mesh, most of whose quads are that small by design.
             let mut raised = 0;
-            let graded = || {
-                let poor = (0..quads.len())
-                    .into_par_iter()
-                    .filter(|&q| setup.value(&mesh.vertices, q) < POOR_QUALITY)
-                    .count();
-                poor as f64 > GRADED_SHARE * quads.len() as f64
-            };
-            if options.quality_repair && options.metric == Metric::ShapeAndSize && !graded() {
+            if options.quality_repair && options.metric == Metric::ShapeAndSize {
                 let slack = energy_before - setup.energy(&mesh.vertices);
                 raised = joint::repair_jointly::<{ joint::BATCH }>(
                     &mut mesh.vertices,
@@ -750,6 +744,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                         slack,
                         passes: 1,
                         later: 0,
+                        graded: (GRADED_SHARE * quads.len() as f64).floor() as usize,
                     },
                 );
             }
