@@ -69,7 +69,7 @@ use std::time::Instant;
 
 use imesh_geom::Point;
 use imesh_quad::Remesh;
-use imesh_quality::QuadQuality;
+use imesh_quality::{QuadHistograms, QuadQuality};
 use rayon::prelude::*;
 
 use crate::variables::{fixed_vertices, vertex_quads, Variables};
@@ -299,6 +299,10 @@ pub struct OptimReport {
     pub before: QuadQuality,
     /// Quality after.
     pub after: QuadQuality,
+    /// The report's histograms before...
+    pub histograms_before: QuadHistograms,
+    /// ... and after.
+    pub histograms_after: QuadHistograms,
 }
 
 /// What every solver needs to know about the energy.
@@ -524,9 +528,10 @@ impl Setup<'_> {
     }
 }
 
-fn quality(vertices: &[Point], quads: &[[u32; 4]]) -> QuadQuality {
+/// The quality of the quads and its histograms, every metric computed once for both.
+fn measure(vertices: &[Point], quads: &[[u32; 4]]) -> (QuadQuality, QuadHistograms) {
     let v: Vec<[f64; 2]> = vertices.iter().map(|p| [p.x, p.y]).collect();
-    QuadQuality::of(&v, quads)
+    QuadQuality::with_histograms(&v, quads)
 }
 
 /// Optimises the quad mesh of `remesh` in place (its control net too, in the control-point
@@ -538,10 +543,41 @@ fn quality(vertices: &[Point], quads: &[[u32; 4]]) -> QuadQuality {
 pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimReport, OptimError> {
     let clock = Instant::now();
     let sliding = options.slide && matches!(options.method, Method::Local | Method::Vertex);
-    let mut sliders = if sliding {
-        slide::Sliders::new(remesh)
-    } else {
-        slide::Sliders::default()
+    if let Some(quad) = (0..remesh.mesh.quads.len())
+        .into_par_iter()
+        .find_first(|&q| !remesh.mesh.is_valid(q))
+    {
+        return Err(OptimError::InvalidStart { quad });
+    }
+    // The variables, the sliders and the start's quality read the mesh only: built side by
+    // side (most of the variables' indexing is sequential).
+    let (prepared, (mut sliders, polish_variables, (before, histograms_before))) = {
+        let r = &*remesh;
+        let t = &r.dt.triangulation;
+        rayon::join(
+            || match options.method {
+                Method::None => None,
+                Method::Laplacian | Method::Vertex => {
+                    Some(Variables::vertices(t, &r.elements, &r.mesh))
+                }
+                Method::Local | Method::Global => {
+                    Some(Variables::control_points(t, &r.elements, &r.net, &r.mesh))
+                }
+            },
+            || {
+                let (sliders, polish) = if sliding {
+                    // The sliding's vertex pass moves the free vertices near the sliders.
+                    let sliders = slide::Sliders::new(r);
+                    let near = sliders.near(&r.mesh.quads, r.mesh.vertices.len(), POLISH_RINGS);
+                    let polish =
+                        Variables::vertices_where(t, &r.elements, &r.mesh, |v| near[v as usize]);
+                    (sliders, Some(polish))
+                } else {
+                    (slide::Sliders::default(), None)
+                };
+                (sliders, polish, measure(&r.mesh.vertices, &r.mesh.quads))
+            },
+        )
     };
     let Remesh {
         dt,
@@ -550,10 +586,6 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         mesh,
         ..
     } = remesh;
-    if let Some(quad) = (0..mesh.quads.len()).find(|&q| !mesh.is_valid(q)) {
-        return Err(OptimError::InvalidStart { quad });
-    }
-    let before = quality(&mesh.vertices, &mesh.quads);
     let quads = mesh.quads.clone();
     let (shape_floors, jacobian_floors): (Vec<f64>, Vec<f64>) = quads
         .par_iter()
@@ -610,23 +642,19 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     setup.quality_floors = &quality_floors;
     let energy_before = setup.energy(&mesh.vertices);
     let t = &dt.triangulation;
-    let (variables, colours, sweeps) = match options.method {
-        Method::None => (0, 0, 0),
-        Method::Laplacian => {
-            let vars = Variables::vertices(t, elements, mesh);
-            let sweeps = laplacian::smooth(&vars, &mut mesh.vertices, &setup);
+    let (variables, colours, sweeps) = match (options.method, &prepared) {
+        (Method::None, _) | (_, None) => (0, 0, 0),
+        (Method::Laplacian, Some(vars)) => {
+            let sweeps = laplacian::smooth(vars, &mut mesh.vertices, &setup);
             (vars.len(), 0, sweeps)
         }
-        Method::Vertex => {
-            let vars = Variables::vertices(t, elements, mesh);
-            let sweeps =
-                local::descend(&vars, &mut mesh.vertices, None, setup, |v| setup.energy(v));
+        (Method::Vertex, Some(vars)) => {
+            let sweeps = local::descend(vars, &mut mesh.vertices, None, setup, |v| setup.energy(v));
             (vars.len(), vars.colours.len(), sweeps)
         }
-        Method::Local => {
-            let vars = Variables::control_points(t, elements, net, mesh);
+        (Method::Local, Some(vars)) => {
             let sweeps = local::descend(
-                &vars,
+                vars,
                 &mut mesh.vertices,
                 Some(&mut net.points),
                 setup,
@@ -634,10 +662,9 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             );
             (vars.len(), vars.colours.len(), sweeps)
         }
-        Method::Global => {
-            let vars = Variables::control_points(t, elements, net, mesh);
+        (Method::Global, Some(vars)) => {
             let iterations = global::minimise(
-                &vars,
+                vars,
                 &mut mesh.vertices,
                 &mut net.points,
                 setup,
@@ -647,18 +674,16 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             (vars.len(), 0, iterations)
         }
     };
-    let sweeps = if sliding {
+    let sweeps = if let Some(vertex_vars) = &polish_variables {
         // The boundary vertices slide along their curves, and the inside follows, every quad
         // held to the same floors (the start's worst scaled Jacobian at least).
         let polish = Setup {
             max_sweeps: POLISH_SWEEPS,
             ..setup
         };
-        let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
-        let vertex_vars = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
         sweeps
             + sliders.sweep(&mut mesh.vertices, &polish, options.max_sweeps)
-            + local::descend(&vertex_vars, &mut mesh.vertices, None, polish, |v| {
+            + local::descend(vertex_vars, &mut mesh.vertices, None, polish, |v| {
                 polish.energy(v)
             })
     } else {
@@ -762,7 +787,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     // Sliding re-evaluates boundary vertices on their curves, the border's too.
     mesh.snap_to_border(t, elements);
     let energy_after = setup.energy(&mesh.vertices);
-    let after = quality(&mesh.vertices, &mesh.quads);
+    let (after, histograms_after) = measure(&mesh.vertices, &mesh.quads);
     Ok(OptimReport {
         method: options.method,
         metric: options.metric,
@@ -779,6 +804,8 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         seconds: clock.elapsed().as_secs_f64(),
         before,
         after,
+        histograms_before,
+        histograms_after,
     })
 }
 

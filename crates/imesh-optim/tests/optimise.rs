@@ -153,6 +153,20 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
         "{method:?} changed the area"
     );
     assert_eq!(r.mesh.quads, start.mesh.quads);
+    // The report measures the start it was given and the mesh it returns, its histograms from
+    // the same values as its statistics.
+    for (m, quality, histograms) in [
+        (start, &report.before, &report.histograms_before),
+        (&r, &report.after, &report.histograms_after),
+    ] {
+        let points: Vec<[f64; 2]> = m.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
+        let (q, h) = imesh_quality::QuadQuality::with_histograms(&points, &m.mesh.quads);
+        assert_eq!((quality, histograms), (&q, &h), "{method:?}");
+        assert_eq!(
+            h.shape_and_size.counts.iter().sum::<usize>(),
+            m.mesh.quads.len()
+        );
+    }
     if method != Method::Laplacian {
         assert!(
             report.energy_after <= report.energy_before,

@@ -35,7 +35,8 @@ mod vec2;
 pub use corner::{sharpest_boundary_corner, BoundaryCorner};
 pub use stats::{Histogram, Statistics};
 pub use summary::{
-    average_quad_area, quad_corners, quad_values, QuadQuality, QuadValues, TriangleQuality,
+    average_quad_area, quad_corners, quad_values, QuadHistograms, QuadQuality, QuadValues,
+    TriangleQuality,
 };
 pub use validate::{signed_area, validate, Domain, Element, MeshView, ValidationReport, Violation};
 

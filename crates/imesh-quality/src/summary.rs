@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{quad, tri, Point2, Statistics};
+use crate::{quad, tri, Histogram, Point2, Statistics};
 
 /// Quality statistics of a quad mesh, as the JSON report's `"quality"` block.
 ///
@@ -23,6 +23,41 @@ pub struct QuadQuality {
     pub min_angle_deg: Statistics,
     /// Maximum angle in degrees (threshold 135°; `below` counts the good ones).
     pub max_angle_deg: Statistics,
+}
+
+/// The report's quality histograms of a quad mesh: shape-and-size and scaled Jacobian, 20 equal
+/// bins over [0, 1] each.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct QuadHistograms {
+    /// Shape-and-size.
+    pub shape_and_size: Histogram,
+    /// Scaled Jacobian.
+    pub scaled_jacobian: Histogram,
+}
+
+impl QuadHistograms {
+    /// Bins of the report's histograms.
+    pub const BINS: usize = 20;
+
+    /// The histograms of per-quad `values`.
+    ///
+    /// ```
+    /// use imesh_quality::{QuadHistograms, QuadValues};
+    /// let v = QuadValues { shape_and_size: 0.42, shape: 0.9, scaled_jacobian: 1.0, min_angle_deg: 90.0, max_angle_deg: 90.0 };
+    /// let h = QuadHistograms::of_values(&[v]);
+    /// assert_eq!(h.shape_and_size.counts[8], 1); // [0.40, 0.45)
+    /// assert_eq!(h.scaled_jacobian.counts[QuadHistograms::BINS - 1], 1);
+    /// ```
+    pub fn of_values(values: &[QuadValues]) -> Self {
+        let histogram = |f: fn(&QuadValues) -> f64| {
+            let column: Vec<f64> = values.iter().map(f).collect();
+            Histogram::of(&column, 0.0, 1.0, Self::BINS)
+        };
+        Self {
+            shape_and_size: histogram(|v| v.shape_and_size),
+            scaled_jacobian: histogram(|v| v.scaled_jacobian),
+        }
+    }
 }
 
 /// Per-quad values of the five reported metrics.
@@ -88,9 +123,33 @@ impl QuadQuality {
     /// assert!((q.scaled_jacobian.min - 1.0).abs() < 1e-15);
     /// ```
     pub fn of(vertices: &[Point2], quads: &[[u32; 4]]) -> Self {
+        Self::with_histograms(vertices, quads).0
+    }
+
+    /// [`QuadQuality::of`] and the [`QuadHistograms`] of the same quads, every metric computed
+    /// once for both.
+    ///
+    /// ```
+    /// use imesh_quality::QuadQuality;
+    /// let v = [[0.0, 0.0], [1.0, 0.0], [3.0, 0.0], [0.0, 1.0], [1.0, 1.0], [3.0, 1.0]];
+    /// let quads = [[0, 1, 4, 3], [1, 2, 5, 4]];
+    /// let (quality, histograms) = QuadQuality::with_histograms(&v, &quads);
+    /// assert_eq!(quality, QuadQuality::of(&v, &quads));
+    /// // The unit square's scaled Jacobian 1 is in the last bin, the rectangle's too.
+    /// assert_eq!(histograms.scaled_jacobian.counts[19], 2);
+    /// ```
+    pub fn with_histograms(vertices: &[Point2], quads: &[[u32; 4]]) -> (Self, QuadHistograms) {
         let corners = quad_corners(vertices, quads);
         let average_area = average_quad_area(&corners);
         let values = quad_values(&corners, average_area);
+        (
+            Self::of_values(&values, average_area),
+            QuadHistograms::of_values(&values),
+        )
+    }
+
+    /// The statistics of per-quad `values` measured against `average_area`.
+    pub fn of_values(values: &[QuadValues], average_area: f64) -> Self {
         let column = |f: fn(&QuadValues) -> f64| values.iter().map(f).collect::<Vec<f64>>();
         Self {
             average_area,

@@ -34,8 +34,8 @@ use imesh_io::SegmentedMeshData;
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 use imesh_quality::{
-    average_quad_area, quad_corners, quad_values, validate, BoundaryCorner, Domain, Element,
-    Histogram, MeshView, QuadQuality, Statistics, TriangleQuality,
+    validate, BoundaryCorner, Domain, Element, Histogram, MeshView, QuadQuality, Statistics,
+    TriangleQuality,
 };
 use imesh_segment::{
     c_edges, merge_regions, merge_thin_regions, partition, sample, CEdge, MergeReport,
@@ -622,19 +622,6 @@ pub struct QualityHistograms {
     pub scaled_jacobian_before: Histogram,
     /// Scaled Jacobian after.
     pub scaled_jacobian_after: Histogram,
-}
-
-/// Shape-and-size and scaled Jacobian histograms of quads (20 bins over [0, 1]).
-fn quad_histograms(vertices: &[imesh_geom::Point], quads: &[[u32; 4]]) -> (Histogram, Histogram) {
-    let points: Vec<[f64; 2]> = vertices.iter().map(|p| [p.x, p.y]).collect();
-    let corners = quad_corners(&points, quads);
-    let values = quad_values(&corners, average_quad_area(&corners));
-    let column =
-        |f: fn(&imesh_quality::QuadValues) -> f64| -> Vec<f64> { values.iter().map(f).collect() };
-    (
-        Histogram::of(&column(|v| v.shape_and_size), 0.0, 1.0, 20),
-        Histogram::of(&column(|v| v.scaled_jacobian), 0.0, 1.0, 20),
-    )
 }
 
 /// The invariant checks' outcome.
@@ -1575,7 +1562,6 @@ impl Pipeline {
             (points, quad_elements(), r.mesh.labels.clone(), Vec::new())
         });
         self.stage(Stage::Optimise);
-        let (sas_before, sj_before) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         let optimisation = optimise(
             &mut r,
             &OptimOptions {
@@ -1589,7 +1575,6 @@ impl Pipeline {
             },
         )?;
         seconds.optimise = optimisation.seconds;
-        let (sas_after, sj_after) = quad_histograms(&r.mesh.vertices, &r.mesh.quads);
         *optimised = Some(QuadExtras {
             hausdorff: fits.max_error.max(fits.max_curve_deviation).max(tip_moved),
             optimisation: Optimisation {
@@ -1607,10 +1592,10 @@ impl Pipeline {
             },
             before: optimisation.before,
             histograms: QualityHistograms {
-                shape_and_size_before: sas_before,
-                shape_and_size_after: sas_after,
-                scaled_jacobian_before: sj_before,
-                scaled_jacobian_after: sj_after,
+                shape_and_size_before: optimisation.histograms_before.shape_and_size,
+                shape_and_size_after: optimisation.histograms_after.shape_and_size,
+                scaled_jacobian_before: optimisation.histograms_before.scaled_jacobian,
+                scaled_jacobian_after: optimisation.histograms_after.scaled_jacobian,
             },
         });
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
