@@ -7,7 +7,9 @@ use std::path::Path;
 use imesh_quality::Element;
 
 use crate::boundary::{boundaries, sanitize};
-use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+use crate::{
+    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
+};
 
 /// The `.inp` text of `mesh`.
 pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
@@ -19,10 +21,10 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         mesh.height,
         mesh.elements.len()
     );
-    for (i, &p) in mesh.vertices.iter().enumerate() {
-        let q = frame.map(mesh, p);
+    push_lines(&mut s, mesh.vertices.len(), |i, s| {
+        let q = frame.map(mesh, mesh.vertices[i]);
         let _ = writeln!(s, "{}, {}, {}", i + 1, q[0], q[1]);
-    }
+    });
     let mut tag = 0usize;
     for (l, name) in mesh.label_names.iter().enumerate() {
         for (kind, corners) in [("CPS3", 3usize), ("CPS4", 4)] {

@@ -174,6 +174,30 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), WriteError> {
     Ok(())
 }
 
+/// Appends `n` lines to `s`, line `i` written by `line(i, part)` into the part being built:
+/// parts of [`LINE_CHUNK`] lines formatted in parallel, then laid end to end in order (the same
+/// text as one line after the other; formatting floats is most of a writer's time).
+pub(crate) fn push_lines(s: &mut String, n: usize, line: impl Fn(usize, &mut String) + Sync) {
+    use rayon::prelude::*;
+    let parts: Vec<String> = (0..n.div_ceil(LINE_CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut part = String::new();
+            for i in c * LINE_CHUNK..((c + 1) * LINE_CHUNK).min(n) {
+                line(i, &mut part);
+            }
+            part
+        })
+        .collect();
+    s.reserve(parts.iter().map(String::len).sum());
+    for part in parts {
+        s.push_str(&part);
+    }
+}
+
+/// Lines per part of [`push_lines`].
+const LINE_CHUNK: usize = 4096;
+
 /// Checks what every writer needs: labels for every element, known vertices.
 pub(crate) fn check(path: &Path, mesh: &SegmentedMeshData) -> Result<(), WriteError> {
     let invalid = |reason: String| WriteError::Invalid {
@@ -203,4 +227,29 @@ pub(crate) fn check(path: &Path, mesh: &SegmentedMeshData) -> Result<(), WriteEr
         return Err(invalid(format!("label {l} has no name")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{push_lines, LINE_CHUNK};
+    use std::fmt::Write as _;
+
+    /// The parts formatted in parallel make the text one line after the other would, whatever
+    /// the count against the part size (none, one, a part less one, a part, a part and one, and
+    /// several parts).
+    #[test]
+    fn lines_formatted_in_parts_are_the_lines_in_order() {
+        let value = |i: usize| (i as f64).sqrt() * if i % 2 == 0 { 1.0 } else { -1e-7 };
+        for n in [0, 1, LINE_CHUNK - 1, LINE_CHUNK, LINE_CHUNK + 1, 3 * LINE_CHUNK + 17] {
+            let mut expected = String::from("head\n");
+            for i in 0..n {
+                let _ = writeln!(expected, "{i} {}", value(i));
+            }
+            let mut s = String::from("head\n");
+            push_lines(&mut s, n, |i, s| {
+                let _ = writeln!(s, "{i} {}", value(i));
+            });
+            assert_eq!(s, expected, "{n} lines");
+        }
+    }
 }

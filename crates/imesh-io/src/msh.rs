@@ -6,7 +6,9 @@ use std::path::Path;
 use imesh_quality::Element;
 
 use crate::boundary::boundaries;
-use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+use crate::{
+    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
+};
 
 /// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
 /// each on its own surface entity carrying the physical surface `label + 1` named after the
@@ -60,12 +62,12 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let n = mapped.len();
     let entity = used.first().map_or(1, |&l| l + 1);
     let _ = writeln!(s, "$Nodes\n1 {n} 1 {n}\n2 {entity} 0 {n}");
-    for i in 1..=n {
-        let _ = writeln!(s, "{i}");
-    }
-    for p in &mapped {
-        let _ = writeln!(s, "{} {} 0", p[0], p[1]);
-    }
+    push_lines(&mut s, n, |i, s| {
+        let _ = writeln!(s, "{}", i + 1);
+    });
+    push_lines(&mut s, n, |i, s| {
+        let _ = writeln!(s, "{} {} 0", mapped[i][0], mapped[i][1]);
+    });
     let _ = writeln!(s, "$EndNodes");
     // Blocks: per label, per element type (triangles first), in one pass over the elements.
     let labels = used.iter().max().map_or(0, |&l| l as usize + 1);
@@ -90,14 +92,14 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut tag = 1usize;
     for (l, kind, members) in &blocks {
         let _ = writeln!(s, "2 {} {kind} {}", l + 1, members.len());
-        for &i in members {
-            let _ = write!(s, "{tag}");
-            for v in written_corners(&mesh.elements[i]) {
+        push_lines(&mut s, members.len(), |k, s| {
+            let _ = write!(s, "{}", tag + k);
+            for v in written_corners(&mesh.elements[members[k]]) {
                 let _ = write!(s, " {}", v + 1);
             }
             s.push('\n');
-            tag += 1;
-        }
+        });
+        tag += members.len();
     }
     // Boundary edges as 2-node lines (type 1) on their curve entities.
     for (i, b) in curves.iter().enumerate() {

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use imesh_quality::Element;
 
-use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+use crate::{
+    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
+};
 
 /// The legacy `.vtk` text of `mesh`, with cell data `label` and each `(name, values)`.
 pub fn vtk_string(
@@ -16,16 +18,20 @@ pub fn vtk_string(
     let mut s = String::new();
     let (n, m) = (mesh.vertices.len(), mesh.elements.len());
     let _ = writeln!(s, "# vtk DataFile Version 3.0\nimesh {}x{} px image\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS {n} double", mesh.width, mesh.height);
-    for &p in &mesh.vertices {
-        let q = frame.map(mesh, p);
+    push_lines(&mut s, n, |i, s| {
+        let q = frame.map(mesh, mesh.vertices[i]);
         let _ = writeln!(s, "{} {} 0", q[0], q[1]);
-    }
+    });
     let size: usize = mesh.elements.iter().map(|e| e.corners().len() + 1).sum();
     let _ = writeln!(s, "CELLS {m} {size}");
-    for e in &mesh.elements {
-        let c: Vec<String> = written_corners(e).iter().map(u32::to_string).collect();
-        let _ = writeln!(s, "{} {}", c.len(), c.join(" "));
-    }
+    push_lines(&mut s, m, |i, s| {
+        let c = written_corners(&mesh.elements[i]);
+        let _ = write!(s, "{}", c.len());
+        for v in c {
+            let _ = write!(s, " {v}");
+        }
+        s.push('\n');
+    });
     let _ = writeln!(s, "CELL_TYPES {m}");
     for e in &mesh.elements {
         let _ = writeln!(

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use imesh_quality::Element;
 
-use crate::{check, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError};
+use crate::{
+    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
+};
 
 /// The `.vtu` text of `mesh`, with cell data `label` and each `(name, values)` of `cell_data`.
 pub fn vtu_string(
@@ -23,19 +25,21 @@ pub fn vtu_string(
         s,
         "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
     );
-    for &p in &mesh.vertices {
-        let q = frame.map(mesh, p);
+    push_lines(&mut s, n, |i, s| {
+        let q = frame.map(mesh, mesh.vertices[i]);
         let _ = writeln!(s, "{} {} 0", q[0], q[1]);
-    }
+    });
     let _ = writeln!(s, "</DataArray>\n</Points>\n<Cells>");
     let _ = writeln!(
         s,
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     );
-    for e in &mesh.elements {
-        let c: Vec<String> = written_corners(e).iter().map(u32::to_string).collect();
-        let _ = writeln!(s, "{}", c.join(" "));
-    }
+    push_lines(&mut s, m, |i, s| {
+        for (k, v) in written_corners(&mesh.elements[i]).into_iter().enumerate() {
+            let _ = write!(s, "{}{v}", if k == 0 { "" } else { " " });
+        }
+        s.push('\n');
+    });
     let _ = writeln!(
         s,
         "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
