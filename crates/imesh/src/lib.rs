@@ -1016,10 +1016,19 @@ impl Pipeline {
         report.input.width = original.width();
         report.input.height = original.height();
         report.fidelity.boundary_hausdorff_px *= sx.max(sy);
-        report.validation.area_ratio =
-            area_ratio(&mesh.vertices, &mesh.elements, &mesh.labels, w, h)?;
-        report.quality = mesh_quality(mesh, self.options.elements);
-        report.label_agreement = agreement_with_original(mesh, original);
+        let mesh = &*mesh;
+        let (area_ratio, (quality, label_agreement)) = rayon::join(
+            || area_ratio(mesh, w, h),
+            || {
+                rayon::join(
+                    || mesh_quality(mesh, self.options.elements),
+                    || agreement_with_original(mesh, original),
+                )
+            },
+        );
+        report.validation.area_ratio = area_ratio?;
+        report.quality = quality;
+        report.label_agreement = label_agreement;
         report.fidelity.label_agreement = report.label_agreement;
         report.seconds.check += check.elapsed().as_secs_f64();
         Ok(())
@@ -1153,14 +1162,6 @@ impl Pipeline {
         });
         let check = Instant::now();
         self.stage(Stage::Check);
-        let area_ratio = area_ratio(&vertices, &elements, &labels, f64::from(w), f64::from(h))?;
-        counts.vertices = vertices.len();
-        counts.elements = elements.len();
-        counts.quads = elements
-            .iter()
-            .filter(|e| matches!(e, Element::Quad(_)))
-            .count();
-        counts.triangles = elements.len() - counts.quads;
         let mesh = SegmentedMeshData {
             vertices,
             elements,
@@ -1170,14 +1171,36 @@ impl Pipeline {
             width: w,
             height: h,
         };
+        counts.vertices = mesh.vertices.len();
+        counts.elements = mesh.elements.len();
+        counts.quads = mesh
+            .elements
+            .iter()
+            .filter(|e| matches!(e, Element::Quad(_)))
+            .count();
+        counts.triangles = mesh.elements.len() - counts.quads;
         counts.meshed_labels = mesh.used_labels().len();
-        let quality = mesh_quality(&mesh, o.elements);
-        let sharpest_boundary_corner = sharpest_boundary_corner(&mesh);
-        // Against the image's own labels, so that the clean-up's changes count as disagreement.
-        let label_agreement = match &cleaned {
-            Some(_) => agreement_with_original(&mesh, original),
-            None => label_agreement(&mesh, grid),
-        };
+        // The checks and measures of the written mesh read it only: side by side.
+        let ((area_ratio, quality), (sharpest_boundary_corner, label_agreement)) = rayon::join(
+            || {
+                rayon::join(
+                    || area_ratio(&mesh, f64::from(w), f64::from(h)),
+                    || mesh_quality(&mesh, o.elements),
+                )
+            },
+            || {
+                rayon::join(
+                    || sharpest_boundary_corner(&mesh),
+                    // Against the image's own labels, so that the clean-up's changes count as
+                    // disagreement.
+                    || match &cleaned {
+                        Some(_) => agreement_with_original(&mesh, original),
+                        None => label_agreement(&mesh, grid),
+                    },
+                )
+            },
+        );
+        let area_ratio = area_ratio?;
         seconds.check = check.elapsed().as_secs_f64();
         seconds.total = classified + start.elapsed().as_secs_f64();
         let report = Report {
@@ -2023,17 +2046,11 @@ pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
 
 /// Validates a mesh on the image domain `w × h` (conforming, exact area, no inverted element,
 /// one known label per element): its area over the domain's, or the violations as an error.
-fn area_ratio(
-    vertices: &[[f64; 2]],
-    elements: &[Element],
-    labels: &[u32],
-    w: f64,
-    h: f64,
-) -> Result<f64, PipelineError> {
+fn area_ratio(mesh: &SegmentedMeshData, w: f64, h: f64) -> Result<f64, PipelineError> {
     let view = MeshView {
-        vertices,
-        elements,
-        labels,
+        vertices: &mesh.vertices,
+        elements: &mesh.elements,
+        labels: &mesh.labels,
     };
     let checked = validate(&view, &Domain::image(w, h));
     if !checked.is_valid() {
