@@ -240,7 +240,14 @@ mod tests {
     #[test]
     fn lines_formatted_in_parts_are_the_lines_in_order() {
         let value = |i: usize| (i as f64).sqrt() * if i % 2 == 0 { 1.0 } else { -1e-7 };
-        for n in [0, 1, LINE_CHUNK - 1, LINE_CHUNK, LINE_CHUNK + 1, 3 * LINE_CHUNK + 17] {
+        for n in [
+            0,
+            1,
+            LINE_CHUNK - 1,
+            LINE_CHUNK,
+            LINE_CHUNK + 1,
+            3 * LINE_CHUNK + 17,
+        ] {
             let mut expected = String::from("head\n");
             for i in 0..n {
                 let _ = writeln!(expected, "{i} {}", value(i));
