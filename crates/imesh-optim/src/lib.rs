@@ -534,6 +534,53 @@ fn measure(vertices: &[Point], quads: &[[u32; 4]]) -> (QuadQuality, QuadHistogra
     QuadQuality::with_histograms(&v, quads)
 }
 
+/// What [`optimise`] builds from the start mesh before it moves anything.
+struct Prepared {
+    /// The method's variables (none for [`Method::None`]).
+    variables: Option<Variables>,
+    /// The sliders, and the free vertices near them that follow them (when sliding).
+    sliders: slide::Sliders,
+    polish_variables: Option<Variables>,
+    /// The start's quality and histograms.
+    before: QuadQuality,
+    histograms_before: QuadHistograms,
+}
+
+/// [`Prepared`] for `method`: the variables on one side, the sliders, the sliding's vertex
+/// variables and the start's quality on the other (all read the mesh only; most of the
+/// variables' indexing is sequential).
+fn prepare(remesh: &Remesh, method: Method, sliding: bool) -> Prepared {
+    let t = &remesh.dt.triangulation;
+    let (elements, mesh) = (&remesh.elements, &remesh.mesh);
+    let (variables, (sliders, polish_variables, (before, histograms_before))) = rayon::join(
+        || match method {
+            Method::None => None,
+            Method::Laplacian | Method::Vertex => Some(Variables::vertices(t, elements, mesh)),
+            Method::Local | Method::Global => {
+                Some(Variables::control_points(t, elements, &remesh.net, mesh))
+            }
+        },
+        || {
+            let (sliders, polish) = if sliding {
+                let sliders = slide::Sliders::new(remesh);
+                let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
+                let polish = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
+                (sliders, Some(polish))
+            } else {
+                (slide::Sliders::default(), None)
+            };
+            (sliders, polish, measure(&mesh.vertices, &mesh.quads))
+        },
+    );
+    Prepared {
+        variables,
+        sliders,
+        polish_variables,
+        before,
+        histograms_before,
+    }
+}
+
 /// Optimises the quad mesh of `remesh` in place (its control net too, in the control-point
 /// modes), keeping every quad valid and every constrained point where it was.
 ///
@@ -549,36 +596,13 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     {
         return Err(OptimError::InvalidStart { quad });
     }
-    // The variables, the sliders and the start's quality read the mesh only: built side by
-    // side (most of the variables' indexing is sequential).
-    let (prepared, (mut sliders, polish_variables, (before, histograms_before))) = {
-        let r = &*remesh;
-        let t = &r.dt.triangulation;
-        rayon::join(
-            || match options.method {
-                Method::None => None,
-                Method::Laplacian | Method::Vertex => {
-                    Some(Variables::vertices(t, &r.elements, &r.mesh))
-                }
-                Method::Local | Method::Global => {
-                    Some(Variables::control_points(t, &r.elements, &r.net, &r.mesh))
-                }
-            },
-            || {
-                let (sliders, polish) = if sliding {
-                    // The sliding's vertex pass moves the free vertices near the sliders.
-                    let sliders = slide::Sliders::new(r);
-                    let near = sliders.near(&r.mesh.quads, r.mesh.vertices.len(), POLISH_RINGS);
-                    let polish =
-                        Variables::vertices_where(t, &r.elements, &r.mesh, |v| near[v as usize]);
-                    (sliders, Some(polish))
-                } else {
-                    (slide::Sliders::default(), None)
-                };
-                (sliders, polish, measure(&r.mesh.vertices, &r.mesh.quads))
-            },
-        )
-    };
+    let Prepared {
+        variables: prepared,
+        mut sliders,
+        polish_variables,
+        before,
+        histograms_before,
+    } = prepare(remesh, options.method, sliding);
     let Remesh {
         dt,
         elements,

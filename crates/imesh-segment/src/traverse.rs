@@ -62,6 +62,26 @@ pub fn touched_pixels(
         }
         return;
     }
+    if [a, b].iter().flatten().all(|v| v.abs() < STEPPED_LIMIT) {
+        stepped_columns(a, b, (c_lo, c_hi), height, visit);
+    } else {
+        general_columns(a, b, (c_lo, c_hi), height, visit);
+    }
+}
+
+/// The columns `c_lo..=c_hi` of a segment that is not vertical, in travel order, with the rows
+/// each touches, for any coordinates: the segment's height at each column's x-limits as exact
+/// fractions (128-bit products), the rows by division ([`stepped_columns`] is the same for
+/// coordinates under 2²⁹, without the divisions).
+fn general_columns(
+    a: Quarter,
+    b: Quarter,
+    (c_lo, c_hi): (i64, i64),
+    height: u32,
+    mut visit: impl FnMut(u32, u32),
+) {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let (xmin, xmax) = (a[0].min(b[0]), a[0].max(b[0]));
     let columns: Box<dyn Iterator<Item = i64>> = if dx > 0 {
         Box::new(c_lo..=c_hi)
     } else {
@@ -95,19 +115,114 @@ pub fn touched_pixels(
         // Rows whose closed y-range meets [ylo, yhi].
         let r_lo = ceil_div_128(ylo.0 - i128::from(SIDE) * ylo.1, i128::from(SIDE) * ylo.1).max(0);
         let r_hi = floor_div_128(yhi.0, i128::from(SIDE) * yhi.1).min(i128::from(height) - 1);
-        if r_lo > r_hi {
-            continue;
+        // Both bounds fit in 64 bits once clamped to the grid (an empty range stays empty).
+        let (r_lo, r_hi) = (r_lo.min(i128::from(height)) as i64, r_hi.max(-1) as i64);
+        visit_rows(c, (r_lo, r_hi), dy, &mut visit);
+    }
+}
+
+/// Visits rows `r_lo..=r_hi` of column `c` in the direction the segment travels (`dy`).
+fn visit_rows(c: i64, (r_lo, r_hi): (i64, i64), dy: i64, visit: &mut impl FnMut(u32, u32)) {
+    if r_lo > r_hi {
+        return;
+    }
+    let col = c as u32;
+    if dy >= 0 {
+        for r in r_lo..=r_hi {
+            visit(col, r as u32);
         }
-        let col = c as u32;
-        if dy >= 0 {
-            for r in r_lo..=r_hi {
-                visit(col, r as u32);
-            }
+    } else {
+        for r in (r_lo..=r_hi).rev() {
+            visit(col, r as u32);
+        }
+    }
+}
+
+/// Coordinates (in quarter pixels) under which [`stepped_columns`] runs: every numerator it
+/// forms, `a.y·|dx| + (x − a.x)·dy` with all of them under 2²⁹, stays under 2⁶¹.
+const STEPPED_LIMIT: i64 = 1 << 29;
+
+/// `n = q · d + r` with `0 ≤ r < d` (`d > 0`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Floor {
+    q: i64,
+    r: i64,
+}
+
+impl Floor {
+    fn of(n: i64, d: i64) -> Self {
+        Self {
+            q: n.div_euclid(d),
+            r: n.rem_euclid(d),
+        }
+    }
+
+    /// `n + step` where `step` is `step.q · d + step.r`: no division.
+    fn plus(self, step: Floor, d: i64) -> Self {
+        let (q, r) = (self.q + step.q, self.r + step.r);
+        if r >= d {
+            Self { q: q + 1, r: r - d }
         } else {
-            for r in (r_lo..=r_hi).rev() {
-                visit(col, r as u32);
-            }
+            Self { q, r }
         }
+    }
+
+    /// `⌈n / d⌉`.
+    fn ceil(self) -> i64 {
+        self.q + i64::from(self.r > 0)
+    }
+}
+
+/// The columns `c_lo..=c_hi` of a segment that is not vertical, in travel order, with the rows
+/// each touches, as the general loop of [`touched_pixels`] finds them: the segment's height at
+/// a column's two x-limits is `y = N / |dx|`, `N = a.y·|dx| + (x − a.x)·dy·sign(dx)`, and the
+/// rows are `⌈N_lo / 4|dx|⌉ − 1 ..= ⌊N_hi / 4|dx|⌋`. On the lines between columns (x a multiple of
+/// 4) `N` grows by the same step from one to the next, so its quotient and remainder by `4|dx|`
+/// are stepped, not divided (only the segment's ends, inside a column, are divided).
+fn stepped_columns(
+    a: Quarter,
+    b: Quarter,
+    (c_lo, c_hi): (i64, i64),
+    height: u32,
+    mut visit: impl FnMut(u32, u32),
+) {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let (xmin, xmax) = (a[0].min(b[0]), a[0].max(b[0]));
+    let slope = dx.signum() * dy;
+    let den = SIDE * dx.abs();
+    let numerator = |x: i64| a[1] * dx.abs() + (x - a[0]) * slope;
+    let last_row = i64::from(height) - 1;
+    // The lines between columns in travel order: entering column c, then leaving it.
+    let forward = dx > 0;
+    let (first_line, line_step) = if forward {
+        (SIDE * c_lo, Floor::of(SIDE * slope, den))
+    } else {
+        (SIDE * (c_hi + 1), Floor::of(-SIDE * slope, den))
+    };
+    let mut line = Floor::of(numerator(first_line), den);
+    for k in 0..=(c_hi - c_lo) {
+        let c = if forward { c_lo + k } else { c_hi - k };
+        let next = line.plus(line_step, den);
+        // The segment's part over column c: its x-limits, clamped to the segment's ends.
+        let (left, right) = if forward { (line, next) } else { (next, line) };
+        let left = if SIDE * c < xmin {
+            Floor::of(numerator(xmin), den)
+        } else {
+            left
+        };
+        let right = if SIDE * c + SIDE > xmax {
+            Floor::of(numerator(xmax), den)
+        } else {
+            right
+        };
+        line = next;
+        let (lo, hi) = (left.min(right), left.max(right));
+        visit_rows(
+            c,
+            ((lo.ceil() - 1).max(0), hi.q.min(last_row)),
+            dy,
+            &mut visit,
+        );
     }
 }
 
@@ -171,6 +286,31 @@ mod tests {
             if n > i128::MIN {
                 proptest::prop_assert_eq!(ceil_div_128(n, d), -(-n).div_euclid(d));
             }
+        }
+    }
+
+    proptest::proptest! {
+        /// The stepped columns are the general ones, pixel for pixel and in the same order:
+        /// short and long segments, either direction, partly or wholly off the grid, with ends
+        /// on and off the lines between pixels, up to the stepped path's limit.
+        #[test]
+        fn stepped_columns_are_the_general_ones(
+            a in proptest::array::uniform2(-40i64..200),
+            b in proptest::array::uniform2(-40i64..200),
+            far in proptest::array::uniform2(-(STEPPED_LIMIT - 1)..STEPPED_LIMIT),
+            use_far in proptest::bool::ANY,
+            (w, h) in (1u32..50, 1u32..50),
+        ) {
+            let b = if use_far { far } else { b };
+            proptest::prop_assume!(a[0] != b[0]);
+            let (xmin, xmax) = (a[0].min(b[0]), a[0].max(b[0]));
+            let c_lo = ceil_div(xmin - SIDE, SIDE).max(0);
+            let c_hi = xmax.div_euclid(SIDE).min(i64::from(w) - 1);
+            proptest::prop_assume!(c_lo <= c_hi);
+            let (mut stepped, mut general) = (Vec::new(), Vec::new());
+            stepped_columns(a, b, (c_lo, c_hi), h, |c, r| stepped.push((c, r)));
+            general_columns(a, b, (c_lo, c_hi), h, |c, r| general.push((c, r)));
+            proptest::prop_assert_eq!(stepped, general);
         }
     }
 
