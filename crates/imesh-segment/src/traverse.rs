@@ -50,15 +50,15 @@ pub fn touched_pixels(
         let (ymin, ymax) = (a[1].min(b[1]), a[1].max(b[1]));
         let r_lo = ceil_div(ymin - SIDE, SIDE).max(0);
         let r_hi = ymax.div_euclid(SIDE).min(i64::from(height) - 1);
-        let rows: Box<dyn Iterator<Item = i64>> = if dy >= 0 {
-            Box::new(r_lo..=r_hi)
-        } else {
-            Box::new((r_lo..=r_hi).rev())
-        };
-        for r in rows {
+        let mut row = |r: i64| {
             for c in c_lo..=c_hi {
                 visit(c as u32, r as u32);
             }
+        };
+        if dy >= 0 {
+            (r_lo..=r_hi).for_each(&mut row);
+        } else {
+            (r_lo..=r_hi).rev().for_each(&mut row);
         }
         return;
     }
