@@ -62,10 +62,37 @@ pub fn touched_pixels(
         }
         return;
     }
+    let span = Span::new(a, b, (c_lo, c_hi), height);
     if [a, b].iter().flatten().all(|v| v.abs() < STEPPED_LIMIT) {
-        stepped_columns(a, b, (c_lo, c_hi), height, visit);
+        stepped_columns(&span, visit);
     } else {
-        general_columns(a, b, (c_lo, c_hi), height, visit);
+        general_columns(&span, visit);
+    }
+}
+
+/// A segment that is not vertical, over the grid columns `columns` (inclusive) of a grid
+/// `height` rows high.
+struct Span {
+    a: Quarter,
+    dx: i64,
+    dy: i64,
+    xmin: i64,
+    xmax: i64,
+    columns: (i64, i64),
+    height: u32,
+}
+
+impl Span {
+    fn new(a: Quarter, b: Quarter, columns: (i64, i64), height: u32) -> Self {
+        Self {
+            a,
+            dx: b[0] - a[0],
+            dy: b[1] - a[1],
+            xmin: a[0].min(b[0]),
+            xmax: a[0].max(b[0]),
+            columns,
+            height,
+        }
     }
 }
 
@@ -73,15 +100,16 @@ pub fn touched_pixels(
 /// each touches, for any coordinates: the segment's height at each column's x-limits as exact
 /// fractions (128-bit products), the rows by division ([`stepped_columns`] is the same for
 /// coordinates under 2²⁹, without the divisions).
-fn general_columns(
-    a: Quarter,
-    b: Quarter,
-    (c_lo, c_hi): (i64, i64),
-    height: u32,
-    mut visit: impl FnMut(u32, u32),
-) {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let (xmin, xmax) = (a[0].min(b[0]), a[0].max(b[0]));
+fn general_columns(span: &Span, mut visit: impl FnMut(u32, u32)) {
+    let &Span {
+        a,
+        dx,
+        dy,
+        xmin,
+        xmax,
+        columns: (c_lo, c_hi),
+        height,
+    } = span;
     let columns: Box<dyn Iterator<Item = i64>> = if dx > 0 {
         Box::new(c_lo..=c_hi)
     } else {
@@ -179,19 +207,13 @@ impl Floor {
 /// rows are `⌈N_lo / 4|dx|⌉ − 1 ..= ⌊N_hi / 4|dx|⌋`. On the lines between columns (x a multiple of
 /// 4) `N` grows by the same step from one to the next, so its quotient and remainder by `4|dx|`
 /// are stepped, not divided (only the segment's ends, inside a column, are divided).
-fn stepped_columns(
-    a: Quarter,
-    b: Quarter,
-    (c_lo, c_hi): (i64, i64),
-    height: u32,
-    mut visit: impl FnMut(u32, u32),
-) {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let (xmin, xmax) = (a[0].min(b[0]), a[0].max(b[0]));
+fn stepped_columns(span: &Span, mut visit: impl FnMut(u32, u32)) {
+    let &Span { a, dx, dy, .. } = span;
+    let ((c_lo, c_hi), (xmin, xmax)) = (span.columns, (span.xmin, span.xmax));
     let slope = dx.signum() * dy;
     let den = SIDE * dx.abs();
     let numerator = |x: i64| a[1] * dx.abs() + (x - a[0]) * slope;
-    let last_row = i64::from(height) - 1;
+    let last_row = i64::from(span.height) - 1;
     // The lines between columns in travel order: entering column c, then leaving it.
     let forward = dx > 0;
     let (first_line, line_step) = if forward {
@@ -307,9 +329,10 @@ mod tests {
             let c_lo = ceil_div(xmin - SIDE, SIDE).max(0);
             let c_hi = xmax.div_euclid(SIDE).min(i64::from(w) - 1);
             proptest::prop_assume!(c_lo <= c_hi);
+            let span = Span::new(a, b, (c_lo, c_hi), h);
             let (mut stepped, mut general) = (Vec::new(), Vec::new());
-            stepped_columns(a, b, (c_lo, c_hi), h, |c, r| stepped.push((c, r)));
-            general_columns(a, b, (c_lo, c_hi), h, |c, r| general.push((c, r)));
+            stepped_columns(&span, |c, r| stepped.push((c, r)));
+            general_columns(&span, |c, r| general.push((c, r)));
             proptest::prop_assert_eq!(stepped, general);
         }
     }
