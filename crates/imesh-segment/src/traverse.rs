@@ -96,10 +96,9 @@ impl Span {
     }
 }
 
-/// The columns `c_lo..=c_hi` of a segment that is not vertical, in travel order, with the rows
-/// each touches, for any coordinates: the segment's height at each column's x-limits as exact
-/// fractions (128-bit products), the rows by division ([`stepped_columns`] is the same for
-/// coordinates under 2²⁹, without the divisions).
+/// The columns of `span` in travel order, with the rows each touches, for any coordinates: the
+/// segment's height at each column's x-limits as exact fractions (128-bit products), the rows by
+/// division ([`stepped_columns`] is the same for coordinates under 2²⁹, without the divisions).
 fn general_columns(span: &Span, mut visit: impl FnMut(u32, u32)) {
     let &Span {
         a,
@@ -201,12 +200,12 @@ impl Floor {
     }
 }
 
-/// The columns `c_lo..=c_hi` of a segment that is not vertical, in travel order, with the rows
-/// each touches, as the general loop of [`touched_pixels`] finds them: the segment's height at
-/// a column's two x-limits is `y = N / |dx|`, `N = a.y·|dx| + (x − a.x)·dy·sign(dx)`, and the
-/// rows are `⌈N_lo / 4|dx|⌉ − 1 ..= ⌊N_hi / 4|dx|⌋`. On the lines between columns (x a multiple of
-/// 4) `N` grows by the same step from one to the next, so its quotient and remainder by `4|dx|`
-/// are stepped, not divided (only the segment's ends, inside a column, are divided).
+/// The columns of `span` in travel order, with the rows each touches, as [`general_columns`]
+/// finds them: the segment's height at a column's two x-limits is `y = N / |dx|`,
+/// `N = a.y·|dx| + (x − a.x)·dy·sign(dx)`, and the rows are `⌈N_lo / 4|dx|⌉ − 1 ..= ⌊N_hi / 4|dx|⌋`.
+/// On the lines between columns (x a multiple of 4) `N` grows by the same step from one to the
+/// next, so its quotient and remainder by `4|dx|` are stepped, not divided (only the segment's
+/// ends, inside a column, are divided).
 fn stepped_columns(span: &Span, mut visit: impl FnMut(u32, u32)) {
     let &Span { a, dx, dy, .. } = span;
     let ((c_lo, c_hi), (xmin, xmax)) = (span.columns, (span.xmin, span.xmax));
