@@ -8,6 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use imesh::{MeshOptions, Pipeline, PipelineResult, Stage};
+use imesh_quality::QuadHistograms;
 use serde::Serialize;
 
 use crate::alloc;
@@ -134,13 +135,18 @@ fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Re
     })
 }
 
-/// The values under 0.25 in `histogram`, which must be the report's twenty bins over [0, 1]:
-/// its first five.
+/// The values under 0.25 in `histogram`, which must be the report's bins over [0, 1]
+/// ([`QuadHistograms::BINS`]): its first quarter.
 fn under_a_quarter(histogram: &imesh_quality::Histogram) -> Result<usize, String> {
-    if histogram.counts.len() != 20 || histogram.lo != 0.0 || histogram.hi != 1.0 {
-        return Err("the shape-and-size histogram is not 20 bins over [0, 1]".into());
+    const BINS: usize = QuadHistograms::BINS;
+    // 0.25 is a bin edge.
+    const _: () = assert!(BINS.is_multiple_of(4));
+    if histogram.counts.len() != BINS || histogram.lo != 0.0 || histogram.hi != 1.0 {
+        return Err(format!(
+            "the shape-and-size histogram is not {BINS} bins over [0, 1]"
+        ));
     }
-    Ok(histogram.counts[..5].iter().sum())
+    Ok(histogram.counts[..BINS / 4].iter().sum())
 }
 
 fn tempdir() -> Result<PathBuf, String> {
