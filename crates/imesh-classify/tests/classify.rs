@@ -19,10 +19,12 @@ fn fixture(name: &str) -> DynamicImage {
     load_image(&fixture_path(name), DEFAULT_MAX_PIXELS).unwrap()
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("imesh-classify-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory, removed with everything in it when dropped.
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("imesh-classify-")
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
@@ -152,7 +154,8 @@ fn label_maps_round_trip_through_a_colour_png() {
         }
         // Written as colours and read back, the partition is the same (colours are distinct).
         if expected <= 12 {
-            let path = temp_dir("roundtrip").join(format!("{name}.png"));
+            let dir = temp_dir();
+            let path = dir.path().join(format!("{name}.png"));
             grid.save_png(&path).unwrap();
             let back = label_map(&load_image(&path, DEFAULT_MAX_PIXELS).unwrap(), 256).unwrap();
             assert_eq!(back.num_labels(), grid.num_labels());
@@ -176,7 +179,8 @@ fn auto_thresholds_a_photograph() {
 
 #[test]
 fn deep_and_alpha_images_load_and_label() {
-    let dir = temp_dir("deep");
+    let scratch = temp_dir();
+    let dir = scratch.path();
     let deep: ImageBuffer<Luma<u16>, Vec<u16>> =
         ImageBuffer::from_fn(20, 10, |x, _| Luma([if x < 10 { 1000 } else { 60000 }]));
     let p16 = dir.join("deep.png");
@@ -212,7 +216,8 @@ fn noise_has_too_many_values_for_a_label_map() {
 
 #[test]
 fn bad_files_are_clear_errors() {
-    let dir = temp_dir("bad");
+    let scratch = temp_dir();
+    let dir = scratch.path();
     let missing = load_image(&dir.join("nope.png"), DEFAULT_MAX_PIXELS).unwrap_err();
     assert!(matches!(missing, ClassifyError::Io { .. }), "{missing}");
     // A truncated PNG: the first half of a real one.
