@@ -30,13 +30,108 @@ impl Boundary {
         }
     }
 
+    /// A label's border split by the side of the domain each edge runs along ([`Side::ALL`]
+    /// order, each side's edges in the boundary's order); all four empty for a boundary between
+    /// two labels.
+    ///
+    /// ```
+    /// use imesh_io::{boundaries, SegmentedMeshData, Side};
+    /// use imesh_quality::Element;
+    /// // One 2 × 1 quad: its border has one edge on each side.
+    /// let mesh = SegmentedMeshData {
+    ///     vertices: vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
+    ///     elements: vec![Element::Quad([0, 3, 2, 1])],
+    ///     labels: vec![0], label_names: vec!["a".into()], label_colours: vec![[0; 3]],
+    ///     width: 2, height: 1,
+    /// };
+    /// let border = &boundaries(&mesh)[0];
+    /// let sides = border.sides(&mesh);
+    /// assert_eq!(sides[Side::Right as usize].len(), 1);
+    /// assert!(sides.iter().all(|edges| edges.len() == 1));
+    /// ```
+    pub fn sides(&self, mesh: &SegmentedMeshData) -> [Vec<[u32; 2]>; 4] {
+        let mut sides: [Vec<[u32; 2]>; 4] = Default::default();
+        if self.labels[1] == OUTSIDE {
+            for &e in &self.edges {
+                sides[Side::of_edge(mesh, e) as usize].push(e);
+            }
+        }
+        sides
+    }
+
     /// The vertices on the boundary, sorted.
     pub fn vertices(&self) -> Vec<u32> {
-        let mut v: Vec<u32> = self.edges.iter().flatten().copied().collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        edge_vertices(&self.edges)
     }
+}
+
+/// A side of the domain rectangle `[0, W] × [0, H]`, named as the image shows it: the top is
+/// row 0 (y = 0 in image coordinates), and stays the top in the written frame, whose y is up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Side {
+    /// x = 0.
+    Left,
+    /// x = W.
+    Right,
+    /// The image's last row: y = H in image coordinates, y = 0 in the written frame.
+    Bottom,
+    /// The image's first row: y = 0 in image coordinates, y = H in the written frame.
+    Top,
+}
+
+impl Side {
+    /// The four sides, in the order the writers list them.
+    pub const ALL: [Side; 4] = [Side::Left, Side::Right, Side::Bottom, Side::Top];
+
+    /// The side's name in the written files: `left`, `right`, `bottom` or `top`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+            Side::Bottom => "bottom",
+            Side::Top => "top",
+        }
+    }
+
+    /// The side of `mesh`'s domain that border edge `edge` lies along: the one nearest its
+    /// midpoint (a border edge lies on one side's line; nearest, rather than equal, so that a
+    /// vertex a rounding away from the line does not lose its edge).
+    ///
+    /// ```
+    /// use imesh_io::{SegmentedMeshData, Side};
+    /// use imesh_quality::Element;
+    /// let mesh = SegmentedMeshData {
+    ///     vertices: vec![[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]],
+    ///     elements: vec![Element::Quad([0, 3, 2, 1])],
+    ///     labels: vec![0], label_names: vec!["a".into()], label_colours: vec![[0; 3]],
+    ///     width: 3, height: 2,
+    /// };
+    /// assert_eq!(Side::of_edge(&mesh, [0, 3]), Side::Left);
+    /// assert_eq!(Side::of_edge(&mesh, [0, 1]), Side::Top); // image row 0
+    /// assert_eq!(Side::of_edge(&mesh, [3, 2]), Side::Bottom);
+    /// ```
+    pub fn of_edge(mesh: &SegmentedMeshData, edge: [u32; 2]) -> Side {
+        let [a, b] = edge.map(|v| mesh.vertices[v as usize]);
+        let (x, y) = ((a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0);
+        let (w, h) = (f64::from(mesh.width), f64::from(mesh.height));
+        let distances = [x, w - x, h - y, y].map(f64::abs);
+        let nearest = (1..4).fold(0, |best, k| {
+            if distances[k] < distances[best] {
+                k
+            } else {
+                best
+            }
+        });
+        Side::ALL[nearest]
+    }
+}
+
+/// The vertices of `edges`, sorted, each once.
+pub(crate) fn edge_vertices(edges: &[[u32; 2]]) -> Vec<u32> {
+    let mut v: Vec<u32> = edges.iter().flatten().copied().collect();
+    v.sort_unstable();
+    v.dedup();
+    v
 }
 
 /// A name fit for solver keywords: letters, digits and `_`, starting with a letter.

@@ -1,12 +1,13 @@
-//! Abaqus `.inp`: nodes, CPS3/CPS4 elements with an element set per label, and a node set per
-//! boundary (between two labels, and the domain border per label).
+//! Abaqus `.inp`: nodes, CPS3/CPS4 elements with an element set per label, a node set per
+//! boundary (between two labels, and the domain border per label), and per side of the domain
+//! (`left`, `right`, `bottom`, `top`) a node set and an element-based surface
+//! (`left_surface`, ...) for boundary conditions and loads.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use imesh_quality::Element;
-
-use crate::boundary::{boundaries, sanitize};
+use crate::boundary::{boundaries, edge_vertices, sanitize, Side};
 use crate::{
     check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
 };
@@ -25,23 +26,26 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         let q = frame.map(mesh, mesh.vertices[i]);
         let _ = writeln!(s, "{}, {}, {}", i + 1, q[0], q[1]);
     });
+    // Per label, its triangles and its quads, in one pass over the elements.
+    let mut members: Vec<[Vec<usize>; 2]> = vec![Default::default(); mesh.label_names.len()];
+    for (i, (e, &l)) in mesh.elements.iter().zip(&mesh.labels).enumerate() {
+        if let Some(m) = members.get_mut(l as usize) {
+            m[usize::from(e.corners().len() == 4)].push(i);
+        }
+    }
+    // Each element's number in the file: by label, then kind.
+    let mut number = vec![0usize; mesh.elements.len()];
     let mut tag = 0usize;
-    for (l, name) in mesh.label_names.iter().enumerate() {
-        for (kind, corners) in [("CPS3", 3usize), ("CPS4", 4)] {
-            let members: Vec<&Element> = mesh
-                .elements
-                .iter()
-                .zip(&mesh.labels)
-                .filter(|(e, &m)| m as usize == l && e.corners().len() == corners)
-                .map(|(e, _)| e)
-                .collect();
+    for (name, kinds) in mesh.label_names.iter().zip(&members) {
+        for (kind, members) in ["CPS3", "CPS4"].into_iter().zip(kinds) {
             if members.is_empty() {
                 continue;
             }
             let _ = writeln!(s, "*Element, type={kind}, elset={}", sanitize(name));
-            for e in members {
+            for &i in members {
                 tag += 1;
-                let ids: Vec<String> = written_corners(e)
+                number[i] = tag;
+                let ids: Vec<String> = written_corners(&mesh.elements[i])
                     .iter()
                     .map(|v| (v + 1).to_string())
                     .collect();
@@ -49,14 +53,84 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             }
         }
     }
-    for b in boundaries(mesh) {
-        let _ = writeln!(s, "*Nset, nset={}", b.name(mesh));
-        for chunk in b.vertices().chunks(16) {
+    let curves = boundaries(mesh);
+    let node_set = |s: &mut String, name: &str, vertices: &[u32]| {
+        let _ = writeln!(s, "*Nset, nset={name}");
+        for chunk in vertices.chunks(16) {
             let ids: Vec<String> = chunk.iter().map(|v| (v + 1).to_string()).collect();
             let _ = writeln!(s, "{}", ids.join(", "));
         }
+    };
+    for b in &curves {
+        node_set(&mut s, &b.name(mesh), &b.vertices());
+    }
+    // The sides of the domain, for boundary conditions: a node set each, and an element-based
+    // surface (the element faces along it, by face number) for loads.
+    let mut sides: [Vec<[u32; 2]>; 4] = Default::default();
+    for b in &curves {
+        for (all, edges) in sides.iter_mut().zip(b.sides(mesh)) {
+            all.extend(edges);
+        }
+    }
+    let faces = side_faces(mesh, &sides);
+    for ((side, edges), faces) in Side::ALL.into_iter().zip(&sides).zip(faces) {
+        if edges.is_empty() {
+            continue;
+        }
+        node_set(&mut s, side.name(), &edge_vertices(edges));
+        // Per face number, the elements with that face on the side.
+        let mut by_face: [Vec<usize>; 4] = Default::default();
+        for (element, face) in faces {
+            by_face[face].push(number[element]);
+        }
+        by_face.iter_mut().for_each(|e| e.sort_unstable());
+        for (face, elements) in by_face.iter().enumerate() {
+            if elements.is_empty() {
+                continue;
+            }
+            let _ = writeln!(s, "*Elset, elset={}_S{}", side.name(), face + 1);
+            for chunk in elements.chunks(16) {
+                let ids: Vec<String> = chunk.iter().map(|e| e.to_string()).collect();
+                let _ = writeln!(s, "{}", ids.join(", "));
+            }
+        }
+        let _ = writeln!(s, "*Surface, type=ELEMENT, name={}_surface", side.name());
+        for (face, elements) in by_face.iter().enumerate() {
+            if !elements.is_empty() {
+                let _ = writeln!(s, "{}_S{}, S{}", side.name(), face + 1, face + 1);
+            }
+        }
     }
     s
+}
+
+/// Per side of the domain (its border edges `sides`, [`Side::ALL`] order), the elements with a
+/// face on it and that face's number less one (Abaqus numbers faces from the first written
+/// corner: face k runs from corner k to the next).
+fn side_faces(mesh: &SegmentedMeshData, sides: &[Vec<[u32; 2]>; 4]) -> [Vec<(usize, usize)>; 4] {
+    let mut side_of: HashMap<[u32; 2], usize> = HashMap::new();
+    let mut on_border = vec![false; mesh.vertices.len()];
+    for (k, edges) in sides.iter().enumerate() {
+        for &[a, b] in edges {
+            side_of.insert([a.min(b), a.max(b)], k);
+            on_border[a as usize] = true;
+            on_border[b as usize] = true;
+        }
+    }
+    let mut faces: [Vec<(usize, usize)>; 4] = Default::default();
+    for (i, e) in mesh.elements.iter().enumerate() {
+        let c = written_corners(e);
+        for k in 0..c.len() {
+            let (a, b) = (c[k], c[(k + 1) % c.len()]);
+            // Only a face with both ends on the border can be on it.
+            if on_border[a as usize] && on_border[b as usize] {
+                if let Some(&side) = side_of.get(&[a.min(b), a.max(b)]) {
+                    faces[side].push((i, k));
+                }
+            }
+        }
+    }
+    faces
 }
 
 /// Writes `mesh` as an Abaqus input file, atomically.

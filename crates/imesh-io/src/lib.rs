@@ -1,7 +1,9 @@
-//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label and a
-//! physical curve per boundary), VTK XML `.vtu` and legacy `.vtk` (cell data: label and quality),
-//! Abaqus `.inp` (an element set per label, a node set per boundary), and SVG and PNG pictures. Every file is written atomically (a temporary
-//! file in the same directory, renamed into place), so a failed run never leaves half a file.
+//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label, and a
+//! physical curve per boundary and per side of the domain), VTK XML `.vtu` and legacy `.vtk`
+//! (cell data: label and quality), Abaqus `.inp` (an element set per label, a node set per
+//! boundary and per side, a surface per side), and SVG and PNG pictures. Every file is written
+//! atomically (a temporary file in the same directory, renamed into place), so a failed run
+//! never leaves half a file.
 //!
 //! Meshes come in image coordinates (y down, elements counter-clockwise there); writers emit the
 //! y-up frame `(x·sx, (H − y)·sy)` with every element counter-clockwise in it.
@@ -41,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use imesh_quality::Element;
 
-pub use boundary::{boundaries, sanitize, Boundary, OUTSIDE};
+pub use boundary::{boundaries, sanitize, Boundary, Side, OUTSIDE};
 pub use histogram::{histogram_picture, write_histogram, HistogramPanel};
 pub use inp::{inp_string, write_inp};
 pub use msh::{msh_string, write_msh};

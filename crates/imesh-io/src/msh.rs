@@ -5,24 +5,52 @@ use std::path::Path;
 
 use imesh_quality::Element;
 
-use crate::boundary::boundaries;
+use crate::boundary::{boundaries, edge_vertices, Side, OUTSIDE};
 use crate::{
     check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
 };
 
 /// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
 /// each on its own surface entity carrying the physical surface `label + 1` named after the
-/// label, then the boundary edges as lines, one curve entity and named physical curve per
-/// boundary (between two labels, or between a label and the domain border).
+/// label, then the boundary edges as lines: a named physical curve per boundary (between two
+/// labels, or between a label and the domain border, tags from 1), and one per side of the
+/// domain (`left`, `right`, `bottom`, `top`, tags after the boundaries', in that order), for
+/// boundary conditions. A boundary between labels is one curve entity; a label's border is one
+/// per side it runs along, each in both its physical curves.
 pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut s = String::new();
     // Writing to a String cannot fail; the results are ignored on purpose.
     let _ = writeln!(s, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
     let used = mesh.used_labels();
     let curves = boundaries(mesh);
-    let _ = writeln!(s, "$PhysicalNames\n{}", used.len() + curves.len());
+    // The curve entities: (its boundary, its side of the domain if on the border, its edges).
+    let mut entities: Vec<(usize, Option<Side>, Vec<[u32; 2]>)> = Vec::new();
+    for (i, b) in curves.iter().enumerate() {
+        if b.labels[1] == OUTSIDE {
+            for (side, edges) in Side::ALL.into_iter().zip(b.sides(mesh)) {
+                if !edges.is_empty() {
+                    entities.push((i, Some(side), edges));
+                }
+            }
+        } else {
+            entities.push((i, None, b.edges.clone()));
+        }
+    }
+    let side_tag = |side: Side| curves.len() + 1 + side as usize;
+    let sides: Vec<Side> = Side::ALL
+        .into_iter()
+        .filter(|&side| entities.iter().any(|e| e.1 == Some(side)))
+        .collect();
+    let _ = writeln!(
+        s,
+        "$PhysicalNames\n{}",
+        used.len() + curves.len() + sides.len()
+    );
     for (i, b) in curves.iter().enumerate() {
         let _ = writeln!(s, "1 {} \"{}\"", i + 1, b.name(mesh));
+    }
+    for &side in &sides {
+        let _ = writeln!(s, "1 {} \"{}\"", side_tag(side), side.name());
     }
     for &l in &used {
         let name = mesh.label_names[l as usize].replace('"', "'");
@@ -31,19 +59,25 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let _ = writeln!(s, "$EndPhysicalNames");
     let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(mesh, p)).collect();
     let (lo, hi) = bounds(&mapped);
-    let _ = writeln!(s, "$Entities\n0 {} {} 0", curves.len(), used.len());
-    for (i, b) in curves.iter().enumerate() {
-        let ends: Vec<[f64; 2]> = b.vertices().iter().map(|&v| mapped[v as usize]).collect();
+    let _ = writeln!(s, "$Entities\n0 {} {} 0", entities.len(), used.len());
+    for (j, (i, side, edges)) in entities.iter().enumerate() {
+        let ends: Vec<[f64; 2]> = edge_vertices(edges)
+            .iter()
+            .map(|&v| mapped[v as usize])
+            .collect();
         let (clo, chi) = bounds(&ends);
+        let physical = match side {
+            Some(side) => format!("2 {} {}", i + 1, side_tag(*side)),
+            None => format!("1 {}", i + 1),
+        };
         let _ = writeln!(
             s,
-            "{} {} {} 0 {} {} 0 1 {} 0",
-            i + 1,
+            "{} {} {} 0 {} {} 0 {physical} 0",
+            j + 1,
             clo[0],
             clo[1],
             chi[0],
             chi[1],
-            i + 1
         );
     }
     for &l in &used {
@@ -88,7 +122,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     }
     let lines: usize = curves.iter().map(|b| b.edges.len()).sum();
     let m = mesh.elements.len() + lines;
-    let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len() + curves.len());
+    let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len() + entities.len());
     let mut tag = 1usize;
     for (l, kind, members) in &blocks {
         let _ = writeln!(s, "2 {} {kind} {}", l + 1, members.len());
@@ -102,9 +136,9 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         tag += members.len();
     }
     // Boundary edges as 2-node lines (type 1) on their curve entities.
-    for (i, b) in curves.iter().enumerate() {
-        let _ = writeln!(s, "1 {} 1 {}", i + 1, b.edges.len());
-        for e in &b.edges {
+    for (j, (_, _, edges)) in entities.iter().enumerate() {
+        let _ = writeln!(s, "1 {} 1 {}", j + 1, edges.len());
+        for e in edges {
             let _ = writeln!(s, "{tag} {} {}", e[0] + 1, e[1] + 1);
             tag += 1;
         }

@@ -100,11 +100,12 @@ proptest! {
         let (nodes, elements, names) = parse_msh(&msh_string(&mesh, &frame));
         prop_assert_eq!(nodes.len(), mesh.vertices.len());
         prop_assert_eq!(elements.len(), mesh.elements.len());
-        // Surfaces: one per label used; curves: a border per label, and even|odd when both exist.
+        // Surfaces: one per label used; curves: a border per label, even|odd when both exist,
+        // and the four sides of the domain.
         let surfaces = names.iter().filter(|n| n.starts_with("2 ")).count();
         let curves = names.iter().filter(|n| n.starts_with("1 ")).count();
         prop_assert_eq!(surfaces, if w > 1 { 2 } else { 1 });
-        prop_assert_eq!(curves, if w > 1 { 3 } else { 1 });
+        prop_assert_eq!(curves, if w > 1 { 3 } else { 1 } + 4);
         let mut total = 0.0;
         for e in &elements {
             let p: Vec<[f64; 2]> = e.iter().map(|&v| nodes[v - 1]).collect();
@@ -228,6 +229,172 @@ proptest! {
             .map(|b| (b.labels[0], b.labels[1], b.edges))
             .collect();
         prop_assert_eq!(ours, boundaries_by_map(&mesh));
+    }
+}
+
+/// The line elements of each named physical curve of MSH 4.1 text, as node pairs (an entity's
+/// lines belong to every physical curve it carries).
+fn msh_curves(text: &str) -> std::collections::BTreeMap<String, Vec<[usize; 2]>> {
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |tag: &str| lines.iter().position(|l| *l == tag).unwrap();
+    let i = at("$PhysicalNames");
+    let n: usize = lines[i + 1].parse().unwrap();
+    let mut name_of = std::collections::HashMap::new();
+    for l in &lines[i + 2..i + 2 + n] {
+        let (head, name) = l.split_once(" \"").unwrap();
+        if let Some(tag) = head.strip_prefix("1 ") {
+            name_of.insert(
+                tag.parse::<usize>().unwrap(),
+                name.trim_end_matches('"').to_string(),
+            );
+        }
+    }
+    let i = at("$Entities");
+    let curves: usize = lines[i + 1].split(' ').nth(1).unwrap().parse().unwrap();
+    let mut physical_of = std::collections::HashMap::new();
+    for l in &lines[i + 2..i + 2 + curves] {
+        let v: Vec<usize> = l
+            .split(' ')
+            .map(|x| x.parse::<f64>().unwrap() as usize)
+            .collect();
+        physical_of.insert(v[0], v[8..8 + v[7]].to_vec());
+    }
+    let mut out: std::collections::BTreeMap<String, Vec<[usize; 2]>> = Default::default();
+    let mut k = at("$Elements") + 2;
+    while lines[k] != "$EndElements" {
+        let head: Vec<usize> = lines[k].split(' ').map(|x| x.parse().unwrap()).collect();
+        let count = head[3];
+        if head[0] == 1 {
+            for l in &lines[k + 1..k + 1 + count] {
+                let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
+                for tag in &physical_of[&head[1]] {
+                    out.entry(name_of[tag].clone())
+                        .or_default()
+                        .push([v[0], v[1]]);
+                }
+            }
+        }
+        k += 1 + count;
+    }
+    out
+}
+
+/// The line the named side lies on in the written frame: (coordinate, value), and its length.
+fn side_line(name: &str, width: f64, height: f64) -> (usize, f64, f64) {
+    match name {
+        "left" => (0, 0.0, height),
+        "right" => (0, width, height),
+        "bottom" => (1, 0.0, width),
+        "top" => (1, height, width),
+        _ => unreachable!("{name}"),
+    }
+}
+
+proptest! {
+    /// The sides of the domain are physical curves whose lines lie on the side's own line and
+    /// cover it exactly once, each also in its label's border; the borders hold every side line.
+    #[test]
+    fn msh_sides_are_the_domain_border_split_four_ways(
+        w in 1u32..7, h in 1u32..7, sx in 0.1f64..3.0, sy in 0.1f64..3.0,
+        seed in proptest::collection::vec(0u32..3, 72),
+    ) {
+        let mut mesh = grid_mesh(w, h);
+        for (k, l) in mesh.labels.iter_mut().enumerate() {
+            *l = seed[k % seed.len()];
+        }
+        mesh.label_names = vec!["a".into(), "b".into(), "c".into()];
+        mesh.label_colours = vec![[0, 0, 0]; 3];
+        let text = msh_string(&mesh, &Frame { pixel_size: [sx, sy] });
+        let (nodes, _, _) = parse_msh(&text);
+        let curves = msh_curves(&text);
+        let (width, height) = (f64::from(w) * sx, f64::from(h) * sy);
+        let mut on_sides = 0;
+        for name in ["left", "right", "bottom", "top"] {
+            let (axis, value, length) = side_line(name, width, height);
+            let lines = &curves[name];
+            let mut covered = 0.0;
+            for &[a, b] in lines {
+                let (p, q) = (nodes[a - 1], nodes[b - 1]);
+                prop_assert!(p[axis] == value && q[axis] == value, "{} line off its side", name);
+                covered += (p[1 - axis] - q[1 - axis]).abs();
+            }
+            prop_assert!((covered - length).abs() <= 1e-9 * length, "{}: {} of {}", name, covered, length);
+            on_sides += lines.len();
+        }
+        let borders: usize = curves
+            .iter()
+            .filter(|(n, _)| n.starts_with("border_"))
+            .map(|(_, l)| l.len())
+            .sum();
+        prop_assert_eq!(borders, on_sides);
+        prop_assert_eq!(on_sides, 2 * (w + h) as usize);
+    }
+}
+
+#[test]
+fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
+    let mesh = grid_mesh(3, 2);
+    let text = inp_string(&mesh, &Frame::default());
+    let lines: Vec<&str> = text.lines().collect();
+    let ids = |l: &str| -> Vec<usize> { l.split(", ").map(|x| x.parse().unwrap()).collect() };
+    // Nodes and elements as written (every line between keywords).
+    let mut nodes = std::collections::HashMap::new();
+    let mut elements = std::collections::HashMap::new();
+    let mut sets: std::collections::HashMap<String, Vec<usize>> = Default::default();
+    let mut keyword = "";
+    for l in &lines {
+        if l.starts_with('*') {
+            keyword = l;
+            continue;
+        }
+        if keyword == "*Node" {
+            let v: Vec<f64> = l.split(", ").map(|x| x.parse().unwrap()).collect();
+            nodes.insert(v[0] as usize, [v[1], v[2]]);
+        } else if keyword.starts_with("*Element") {
+            let v = ids(l);
+            elements.insert(v[0], v[1..].to_vec());
+        } else if let Some(name) = keyword
+            .strip_prefix("*Nset, nset=")
+            .or(keyword.strip_prefix("*Elset, elset="))
+        {
+            sets.entry(name.to_string()).or_default().extend(ids(l));
+        }
+    }
+    for name in ["left", "right", "bottom", "top"] {
+        let (axis, value, length) = side_line(name, 3.0, 2.0);
+        // The node set: every node on the side's line, and only those.
+        let mut want: Vec<usize> = nodes
+            .iter()
+            .filter(|(_, p)| p[axis] == value)
+            .map(|(&k, _)| k)
+            .collect();
+        want.sort_unstable();
+        assert_eq!(sets[name], want, "{name}");
+        // The surface: its faces lie on the line and cover it once.
+        let surface = format!("*Surface, type=ELEMENT, name={name}_surface");
+        let at = lines
+            .iter()
+            .position(|l| *l == surface)
+            .expect("a surface per side");
+        let mut covered = 0.0;
+        for l in lines[at + 1..].iter().take_while(|l| !l.starts_with('*')) {
+            let (set, face) = l.split_once(", S").unwrap();
+            let face: usize = face.parse().unwrap();
+            assert_eq!(set, format!("{name}_S{face}"));
+            for e in &sets[set] {
+                let corners = &elements[e];
+                let (p, q) = (
+                    nodes[&corners[face - 1]],
+                    nodes[&corners[face % corners.len()]],
+                );
+                assert!(
+                    p[axis] == value && q[axis] == value,
+                    "{name}: element {e} face {face}"
+                );
+                covered += (p[1 - axis] - q[1 - axis]).abs();
+            }
+        }
+        assert_eq!(covered, length, "{name}");
     }
 }
 

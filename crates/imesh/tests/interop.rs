@@ -6,6 +6,9 @@
 use std::path::Path;
 use std::process::Command;
 
+/// The sides of the domain, as the writers name them.
+const SIDES: [&str; 4] = ["left", "right", "bottom", "top"];
+
 fn meshio_read(python: &str, file: &Path) -> serde_json::Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/read_mesh.py");
     let out = Command::new(python)
@@ -102,8 +105,35 @@ fn meshio_reads_every_format_we_write() {
                 assert!(names.iter().any(|n| n.starts_with("border_")), "{what}");
                 assert!(read["cells"]["line"].as_u64().unwrap() > 0, "{what}");
             } else if name.ends_with(".inp") {
-                // An element set per label.
-                assert_eq!(count("cell_sets"), labels, "{what}");
+                // An element set per label, and per side of the domain those of the faces of
+                // its surface; a node set per side.
+                let sets: Vec<&str> = read["cell_sets"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|n| n.as_str().unwrap())
+                    .collect();
+                let is_face_set = |n: &str| {
+                    SIDES
+                        .iter()
+                        .any(|side| n.strip_prefix(side).is_some_and(|f| f.starts_with("_S")))
+                };
+                let label_sets = sets.iter().filter(|n| !is_face_set(n)).count();
+                assert_eq!(label_sets as u64, labels, "{what}: {sets:?}");
+                for side in SIDES {
+                    assert!(
+                        sets.iter().any(|n| n.starts_with(&format!("{side}_S"))),
+                        "{what}: {side}"
+                    );
+                    assert!(
+                        read["point_sets"]
+                            .as_array()
+                            .unwrap()
+                            .iter()
+                            .any(|n| n == side),
+                        "{what}: {side}"
+                    );
+                }
             } else {
                 // Every label the elements carry, each a label of the grid.
                 assert_eq!(count("labels"), labels, "{what}");
@@ -201,5 +231,30 @@ fn gmsh_opens_our_msh_with_the_same_physical_groups() {
             .iter()
             .any(|g| g["name"].as_str().unwrap().starts_with("border_")));
         assert!(curves.iter().all(|g| g["elements"].as_u64().unwrap() > 0));
+        // The four sides of the domain, each a curve of lines whose nodes lie on its line (the
+        // written frame: y up, a pixel a unit).
+        let (w, h) = (
+            report["input"]["width"].as_f64().unwrap(),
+            report["input"]["height"].as_f64().unwrap(),
+        );
+        for (side, axis, at, along) in [
+            ("left", "x", 0.0, h),
+            ("right", "x", w, h),
+            ("bottom", "y", 0.0, w),
+            ("top", "y", h, w),
+        ] {
+            let g = curves
+                .iter()
+                .find(|g| g["name"] == side)
+                .unwrap_or_else(|| panic!("{fixture}: no {side} curve"));
+            assert!(g["elements"].as_u64().unwrap() > 0, "{fixture}: {side}");
+            assert_eq!(g[axis], serde_json::json!([at, at]), "{fixture}: {side}");
+            let across = if axis == "x" { "y" } else { "x" };
+            assert_eq!(
+                g[across],
+                serde_json::json!([0.0, along]),
+                "{fixture}: {side}"
+            );
+        }
     }
 }

@@ -33,6 +33,7 @@ print(json.dumps({
     "physical": physical,
     "names": sorted(mesh.field_data.keys()),
     "cell_sets": sorted(mesh.cell_sets.keys()),
+    "point_sets": sorted(mesh.point_sets.keys()),
     "negative": int(negative),
     "area": float(area),
 }))
