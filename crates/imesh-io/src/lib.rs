@@ -92,27 +92,43 @@ impl SegmentedMeshData {
     }
 }
 
-/// The written frame: y up, scaled by a physical pixel size.
+/// The written frame: y up, scaled by a physical pixel size, and placed with the image's
+/// bottom-left corner at an origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     /// Size of a pixel along x and y (default 1).
     pub pixel_size: [f64; 2],
+    /// Where the image's bottom-left corner goes (default 0, 0).
+    pub origin: [f64; 2],
 }
 
 impl Default for Frame {
     fn default() -> Self {
         Self {
             pixel_size: [1.0, 1.0],
+            origin: [0.0, 0.0],
         }
     }
 }
 
 impl Frame {
-    /// A vertex in the written frame.
+    /// A vertex in the written frame: `(x · sx + ox, (H − y) · sy + oy)`.
+    ///
+    /// ```
+    /// use imesh_io::{Frame, SegmentedMeshData};
+    /// let mesh = SegmentedMeshData {
+    ///     vertices: vec![], elements: vec![], labels: vec![],
+    ///     label_names: vec![], label_colours: vec![], width: 4, height: 3,
+    /// };
+    /// // Pixels of 0.5 mm, the image's bottom-left corner at (10, 20) mm.
+    /// let frame = Frame { pixel_size: [0.5, 0.5], origin: [10.0, 20.0] };
+    /// assert_eq!(frame.map(&mesh, [0.0, 3.0]), [10.0, 20.0]); // the bottom-left corner
+    /// assert_eq!(frame.map(&mesh, [4.0, 0.0]), [12.0, 21.5]); // the top-right one
+    /// ```
     pub fn map(&self, mesh: &SegmentedMeshData, p: [f64; 2]) -> [f64; 2] {
         [
-            p[0] * self.pixel_size[0],
-            (f64::from(mesh.height) - p[1]) * self.pixel_size[1],
+            p[0] * self.pixel_size[0] + self.origin[0],
+            (f64::from(mesh.height) - p[1]) * self.pixel_size[1] + self.origin[1],
         ]
     }
 }

@@ -94,9 +94,12 @@ fn signed_area(p: &[[f64; 2]]) -> f64 {
 
 proptest! {
     #[test]
-    fn msh_is_y_up_counter_clockwise_and_covers_the_scaled_domain(w in 1u32..8, h in 1u32..8, sx in 0.1f64..3.0, sy in 0.1f64..3.0) {
+    fn msh_is_y_up_counter_clockwise_and_covers_the_scaled_domain(
+        w in 1u32..8, h in 1u32..8, sx in 0.1f64..3.0, sy in 0.1f64..3.0,
+        ox in -1e3f64..1e3, oy in -1e3f64..1e3,
+    ) {
         let mesh = grid_mesh(w, h);
-        let frame = Frame { pixel_size: [sx, sy] };
+        let frame = Frame { pixel_size: [sx, sy], origin: [ox, oy] };
         let (nodes, elements, names) = parse_msh(&msh_string(&mesh, &frame));
         prop_assert_eq!(nodes.len(), mesh.vertices.len());
         prop_assert_eq!(elements.len(), mesh.elements.len());
@@ -115,8 +118,10 @@ proptest! {
         }
         let want = f64::from(w) * sx * f64::from(h) * sy;
         prop_assert!((total - want).abs() <= 1e-9 * want);
-        // y up: image row 0 is at the top.
-        prop_assert_eq!(nodes[0][1], f64::from(h) * sy);
+        // y up: image row 0 is at the top; the image's bottom-left corner at the origin.
+        prop_assert_eq!(nodes[0], [ox, f64::from(h) * sy + oy]);
+        let bottom_left = (h * (w + 1)) as usize;
+        prop_assert_eq!(nodes[bottom_left], [ox, oy]);
     }
 }
 
@@ -296,6 +301,7 @@ proptest! {
     #[test]
     fn msh_sides_are_the_domain_border_split_four_ways(
         w in 1u32..7, h in 1u32..7, sx in 0.1f64..3.0, sy in 0.1f64..3.0,
+        ox in -1e3f64..1e3, oy in -1e3f64..1e3,
         seed in proptest::collection::vec(0u32..3, 72),
     ) {
         let mut mesh = grid_mesh(w, h);
@@ -304,13 +310,15 @@ proptest! {
         }
         mesh.label_names = vec!["a".into(), "b".into(), "c".into()];
         mesh.label_colours = vec![[0, 0, 0]; 3];
-        let text = msh_string(&mesh, &Frame { pixel_size: [sx, sy] });
+        let text = msh_string(&mesh, &Frame { pixel_size: [sx, sy], origin: [ox, oy] });
         let (nodes, _, _) = parse_msh(&text);
         let curves = msh_curves(&text);
         let (width, height) = (f64::from(w) * sx, f64::from(h) * sy);
         let mut on_sides = 0;
         for name in ["left", "right", "bottom", "top"] {
             let (axis, value, length) = side_line(name, width, height);
+            // The writer's own arithmetic: `0 · s + o` and `W · s + o`, exactly.
+            let value = value + [ox, oy][axis];
             let lines = &curves[name];
             let mut covered = 0.0;
             for &[a, b] in lines {
@@ -318,7 +326,8 @@ proptest! {
                 prop_assert!(p[axis] == value && q[axis] == value, "{} line off its side", name);
                 covered += (p[1 - axis] - q[1 - axis]).abs();
             }
-            prop_assert!((covered - length).abs() <= 1e-9 * length, "{}: {} of {}", name, covered, length);
+            let tolerance = 1e-9 * (length + ox.abs() + oy.abs());
+            prop_assert!((covered - length).abs() <= tolerance, "{}: {} of {}", name, covered, length);
             on_sides += lines.len();
         }
         let borders: usize = curves

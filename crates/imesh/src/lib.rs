@@ -343,6 +343,9 @@ pub struct MeshOptions {
     pub global_iterations: u64,
     /// Size of a pixel along x and y in the written mesh.
     pub pixel_size: [f64; 2],
+    /// Where the image's bottom-left corner lies in the written mesh (in the pixel size's
+    /// units; default 0, 0).
+    pub origin: [f64; 2],
     /// Largest image accepted, in pixels.
     pub max_pixels: u64,
     /// Most labels a label map may have.
@@ -382,6 +385,7 @@ impl Default for MeshOptions {
             metric: MetricName::ShapeAndSize,
             global_iterations: OptimOptions::default().global_iterations,
             pixel_size: [1.0, 1.0],
+            origin: [0.0, 0.0],
             max_pixels: imesh_classify::DEFAULT_MAX_PIXELS,
             max_labels: imesh_classify::DEFAULT_MAX_LABELS,
             max_elements: DEFAULT_MAX_ELEMENTS,
@@ -1748,6 +1752,12 @@ impl Pipeline {
             return Err(PipelineError::Options(format!(
                 "the pixel size must be positive, not {:?}",
                 o.pixel_size
+            )));
+        }
+        if !o.origin.iter().all(|x| x.is_finite()) {
+            return Err(PipelineError::Options(format!(
+                "the origin must be two finite numbers, not {:?}",
+                o.origin
             )));
         }
         Ok(())

@@ -179,6 +179,10 @@ struct MeshFlags {
     /// Physical size of a pixel: SX or SX,SY.
     #[arg(long, value_parser = parse_pixel_size)]
     pixel_size: Option<[f64; 2]>,
+    /// Where the image's bottom-left corner lies in the written mesh: X,Y, in the pixel size's
+    /// units [default: 0,0].
+    #[arg(long, value_parser = parse_origin, allow_hyphen_values = true)]
+    origin: Option<[f64; 2]>,
     /// Largest image accepted, in pixels [default: 268435456, a 16384 × 16384 image].
     #[arg(long)]
     max_pixels: Option<u64>,
@@ -226,6 +230,19 @@ fn parse_pixel_size(s: &str) -> Result<[f64; 2], String> {
         }
         [x, y] => Ok([parse(x)?, parse(y)?]),
         _ => Err("give SX or SX,SY".into()),
+    }
+}
+
+fn parse_origin(s: &str) -> Result<[f64; 2], String> {
+    match s.split(',').collect::<Vec<_>>().as_slice() {
+        [x, y] => {
+            let parse = |p: &str| match p.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!("{p:?} is not a finite number")),
+            };
+            Ok([parse(x)?, parse(y)?])
+        }
+        _ => Err("give X,Y".into()),
     }
 }
 
@@ -308,6 +325,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(p) = args.pixel_size {
         o.pixel_size = p;
+    }
+    if let Some(p) = args.origin {
+        o.origin = p;
     }
     if let Some(n) = args.max_pixels {
         o.max_pixels = n;
@@ -539,6 +559,7 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
     }
     let frame = Frame {
         pixel_size: options.pixel_size,
+        origin: options.origin,
     };
     // A spinner naming the running stage, on stderr, only for a person watching.
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
@@ -755,6 +776,7 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot create the folder {}: {e}", args.output.display()))?;
     let frame = Frame {
         pixel_size: options.pixel_size,
+        origin: options.origin,
     };
     let pipeline = Pipeline::new(options);
     // One image per task; each image's stages use the same pool for their own parallel work.

@@ -228,6 +228,53 @@ fn vtu_output_and_options() {
 }
 
 #[test]
+fn pixel_size_and_origin_place_the_image_in_the_written_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("pyvista-channels_z050_labels.png"); // 250 × 250 px
+    let out = imesh(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "-o",
+            "m.msh",
+            "--pixel-size",
+            "0.5,2",
+            "--origin",
+            "-100,25.5",
+            "--report",
+            "r.json",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let msh = std::fs::read_to_string(dir.path().join("m.msh")).unwrap();
+    let lines: Vec<&str> = msh.lines().collect();
+    let at = lines.iter().position(|l| *l == "$Nodes").unwrap();
+    let n: usize = lines[at + 1].split(' ').nth(1).unwrap().parse().unwrap();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for l in &lines[at + 3 + n..at + 3 + 2 * n] {
+        let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+        for k in 0..2 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    // The image's bottom-left corner at the origin, 250 px of 0.5 and 2 units to the right and up.
+    assert_eq!((lo, hi), ([-100.0, 25.5], [25.0, 525.5]));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(
+        report["options"]["origin"],
+        serde_json::json!([-100.0, 25.5])
+    );
+}
+
+#[test]
 fn abaqus_and_legacy_vtk_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("pyvista-channels_z050_labels.png");
@@ -250,6 +297,13 @@ fn abaqus_and_legacy_vtk_outputs() {
     );
     assert!(!inp.contains("CPS3"), "the default mesh is all quads");
     assert!(inp.contains("*Nset, nset=border_"));
+    for side in ["left", "right", "bottom", "top"] {
+        assert!(inp.contains(&format!("*Nset, nset={side}\n")), "{side}");
+        assert!(
+            inp.contains(&format!("*Surface, type=ELEMENT, name={side}_surface\n")),
+            "{side}"
+        );
+    }
     let vtk = std::fs::read_to_string(dir.path().join("m.vtk")).unwrap();
     assert!(vtk.contains("SCALARS label int 1") && vtk.contains("SCALARS shape double 1"));
 }
@@ -409,6 +463,8 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         ),
         (&["mesh", image, "--min-width=-2"], "smallest region width"),
         (&["mesh", image, "--reduction", "0"], "a reduction of 0"),
+        (&["mesh", image, "--origin", "5"], "give X,Y"),
+        (&["mesh", image, "--origin", "1,inf"], "finite number"),
         (
             &["mesh", image, "--reduction", "half"],
             "neither auto nor a number",
