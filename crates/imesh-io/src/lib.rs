@@ -1,4 +1,4 @@
-//! Writers for segmented 2D meshes: Gmsh MSH 4.1 (a named physical surface per label, and a
+//! Writers for segmented 2D meshes: Gmsh MSH 4.1 and 2.2 (a named physical surface per label, and a
 //! physical curve per boundary and per side of the domain), VTK XML `.vtu` and legacy `.vtk`
 //! (cell data: label and quality), Abaqus `.inp` (an element set per label, a node set per
 //! boundary and per side, a surface per side), and SVG and PNG pictures. Every file is written
@@ -46,7 +46,7 @@ use imesh_quality::Element;
 pub use boundary::{boundaries, sanitize, Boundary, Side, OUTSIDE};
 pub use histogram::{histogram_picture, write_histogram, HistogramPanel};
 pub use inp::{inp_string, write_inp};
-pub use msh::{msh_string, write_msh};
+pub use msh::{msh22_string, msh_string, write_msh, write_msh22};
 pub use png::{rasterise, write_png};
 pub use read::{read_mesh, ReadError, ReadMesh};
 pub use svg::{svg_string, write_svg, SvgOptions};

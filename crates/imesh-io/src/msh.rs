@@ -1,11 +1,12 @@
-//! Gmsh MSH 4.1 ASCII: one surface entity and one named physical surface per label.
+//! Gmsh MSH 4.1 ASCII (and 2.2 for older readers): a named physical surface per label, and named
+//! physical curves for the boundaries and the sides of the domain.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use imesh_quality::Element;
 
-use crate::boundary::{boundaries, edge_vertices, Side, OUTSIDE};
+use crate::boundary::{boundaries, edge_vertices, Boundary, Side, OUTSIDE};
 use crate::{
     check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
 };
@@ -21,42 +22,9 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut s = String::new();
     // Writing to a String cannot fail; the results are ignored on purpose.
     let _ = writeln!(s, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
-    let used = mesh.used_labels();
-    let curves = boundaries(mesh);
-    // The curve entities: (its boundary, its side of the domain if on the border, its edges).
-    let mut entities: Vec<(usize, Option<Side>, Vec<[u32; 2]>)> = Vec::new();
-    for (i, b) in curves.iter().enumerate() {
-        if b.labels[1] == OUTSIDE {
-            for (side, edges) in Side::ALL.into_iter().zip(b.sides(mesh)) {
-                if !edges.is_empty() {
-                    entities.push((i, Some(side), edges));
-                }
-            }
-        } else {
-            entities.push((i, None, b.edges.clone()));
-        }
-    }
-    let side_tag = |side: Side| curves.len() + 1 + side as usize;
-    let sides: Vec<Side> = Side::ALL
-        .into_iter()
-        .filter(|&side| entities.iter().any(|e| e.1 == Some(side)))
-        .collect();
-    let _ = writeln!(
-        s,
-        "$PhysicalNames\n{}",
-        used.len() + curves.len() + sides.len()
-    );
-    for (i, b) in curves.iter().enumerate() {
-        let _ = writeln!(s, "1 {} \"{}\"", i + 1, b.name(mesh));
-    }
-    for &side in &sides {
-        let _ = writeln!(s, "1 {} \"{}\"", side_tag(side), side.name());
-    }
-    for &l in &used {
-        let name = mesh.label_names[l as usize].replace('"', "'");
-        let _ = writeln!(s, "2 {} \"{}\"", l + 1, name);
-    }
-    let _ = writeln!(s, "$EndPhysicalNames");
+    let groups = Groups::of(mesh);
+    groups.write_names(mesh, &mut s);
+    let Groups { used, entities, .. } = &groups;
     let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(mesh, p)).collect();
     let (lo, hi) = bounds(&mapped);
     let _ = writeln!(s, "$Entities\n0 {} {} 0", entities.len(), used.len());
@@ -66,10 +34,9 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             .map(|&v| mapped[v as usize])
             .collect();
         let (clo, chi) = bounds(&ends);
-        let physical = match side {
-            Some(side) => format!("2 {} {}", i + 1, side_tag(*side)),
-            None => format!("1 {}", i + 1),
-        };
+        let tags = groups.physical_tags(*i, *side);
+        let physical: Vec<String> = tags.iter().map(|t| t.to_string()).collect();
+        let physical = format!("{} {}", tags.len(), physical.join(" "));
         let _ = writeln!(
             s,
             "{} {} {} 0 {} {} 0 {physical} 0",
@@ -80,7 +47,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             chi[1],
         );
     }
-    for &l in &used {
+    for &l in used {
         let _ = writeln!(
             s,
             "{} {} {} 0 {} {} 0 1 {} 0",
@@ -110,7 +77,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         members[l as usize][usize::from(gmsh_type(e) == 3)].push(i);
     }
     let mut blocks: Vec<(u32, u32, Vec<usize>)> = Vec::new();
-    for &l in &used {
+    for &l in used {
         for (kind, members) in [2u32, 3]
             .into_iter()
             .zip(std::mem::take(&mut members[l as usize]))
@@ -120,7 +87,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             }
         }
     }
-    let lines: usize = curves.iter().map(|b| b.edges.len()).sum();
+    let lines: usize = entities.iter().map(|e| e.2.len()).sum();
     let m = mesh.elements.len() + lines;
     let _ = writeln!(s, "$Elements\n{} {m} 1 {m}", blocks.len() + entities.len());
     let mut tag = 1usize;
@@ -145,6 +112,148 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     }
     let _ = writeln!(s, "$EndElements");
     s
+}
+
+/// The physical groups of a mesh's MSH file, and the curve entities that carry the curves.
+struct Groups {
+    /// The labels the elements carry (a physical surface each, tag `label + 1`).
+    used: Vec<u32>,
+    /// The boundaries (a physical curve each, tags from 1).
+    curves: Vec<Boundary>,
+    /// The curve entities: its boundary, its side of the domain if on the border, its edges.
+    entities: Vec<(usize, Option<Side>, Vec<[u32; 2]>)>,
+    /// The sides of the domain with edges (a physical curve each, after the boundaries').
+    sides: Vec<Side>,
+}
+
+impl Groups {
+    /// A boundary between labels is one curve entity; a label's border is one per side of
+    /// the domain it runs along.
+    fn of(mesh: &SegmentedMeshData) -> Self {
+        let curves = boundaries(mesh);
+        let mut entities = Vec::new();
+        for (i, b) in curves.iter().enumerate() {
+            if b.labels[1] == OUTSIDE {
+                for (side, edges) in Side::ALL.into_iter().zip(b.sides(mesh)) {
+                    if !edges.is_empty() {
+                        entities.push((i, Some(side), edges));
+                    }
+                }
+            } else {
+                entities.push((i, None, b.edges.clone()));
+            }
+        }
+        let sides = Side::ALL
+            .into_iter()
+            .filter(|&side| entities.iter().any(|e| e.1 == Some(side)))
+            .collect();
+        Self {
+            used: mesh.used_labels(),
+            curves,
+            entities,
+            sides,
+        }
+    }
+
+    /// The physical curve of `side`.
+    fn side_tag(&self, side: Side) -> usize {
+        self.curves.len() + 1 + side as usize
+    }
+
+    /// The physical curves of an entity of boundary `boundary` along `side`: the boundary's,
+    /// then the side's.
+    fn physical_tags(&self, boundary: usize, side: Option<Side>) -> Vec<usize> {
+        std::iter::once(boundary + 1)
+            .chain(side.map(|side| self.side_tag(side)))
+            .collect()
+    }
+
+    /// The `$PhysicalNames` section (the same in both versions).
+    fn write_names(&self, mesh: &SegmentedMeshData, s: &mut String) {
+        let count = self.used.len() + self.curves.len() + self.sides.len();
+        let _ = writeln!(s, "$PhysicalNames\n{count}");
+        for (i, b) in self.curves.iter().enumerate() {
+            let _ = writeln!(s, "1 {} \"{}\"", i + 1, b.name(mesh));
+        }
+        for &side in &self.sides {
+            let _ = writeln!(s, "1 {} \"{}\"", self.side_tag(side), side.name());
+        }
+        for &l in &self.used {
+            let name = mesh.label_names[l as usize].replace('"', "'");
+            let _ = writeln!(s, "2 {} \"{}\"", l + 1, name);
+        }
+        let _ = writeln!(s, "$EndPhysicalNames");
+    }
+}
+
+/// The MSH 2.2 text of `mesh`, for readers that know no other (MFEM, OpenFOAM's `gmshToFoam`,
+/// older FEniCS tools): the same physical groups as [`msh_string`], each element tagged with
+/// its physical group and its entity (a label's surface, or its [`msh_string`] curve entity).
+/// Version 2 gives an element one physical group, so a border line is written once for its
+/// label's border and once again for its side of the domain, as Gmsh itself writes an element
+/// of two groups.
+///
+/// ```
+/// use imesh_io::{msh22_string, Frame, SegmentedMeshData};
+/// use imesh_quality::Element;
+/// let mesh = SegmentedMeshData {
+///     vertices: vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
+///     elements: vec![Element::Quad([0, 1, 2, 3])],
+///     labels: vec![0], label_names: vec!["steel".into()], label_colours: vec![[0; 3]],
+///     width: 2, height: 1,
+/// };
+/// let text = msh22_string(&mesh, &Frame::default());
+/// assert!(text.starts_with("$MeshFormat\n2.2 0 8\n"));
+/// // The quad (type 3) in physical surface 1 "steel"; four border lines, each twice.
+/// assert!(text.contains("\n$Elements\n9\n1 3 2 1 1 "));
+/// ```
+pub fn msh22_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "$MeshFormat\n2.2 0 8\n$EndMeshFormat");
+    let groups = Groups::of(mesh);
+    groups.write_names(mesh, &mut s);
+    let n = mesh.vertices.len();
+    let _ = writeln!(s, "$Nodes\n{n}");
+    push_lines(&mut s, n, |i, s| {
+        let q = frame.map(mesh, mesh.vertices[i]);
+        let _ = writeln!(s, "{} {} {} 0", i + 1, q[0], q[1]);
+    });
+    let _ = writeln!(s, "$EndNodes");
+    let lines: Vec<(usize, usize, [u32; 2])> = groups
+        .entities
+        .iter()
+        .enumerate()
+        .flat_map(|(j, (i, side, edges))| {
+            let tags = groups.physical_tags(*i, *side);
+            edges
+                .iter()
+                .flat_map(move |&e| tags.clone().into_iter().map(move |tag| (tag, j + 1, e)))
+        })
+        .collect();
+    let _ = writeln!(s, "$Elements\n{}", mesh.elements.len() + lines.len());
+    push_lines(&mut s, mesh.elements.len(), |i, s| {
+        let (e, l) = (&mesh.elements[i], mesh.labels[i] + 1);
+        let _ = write!(s, "{} {} 2 {l} {l}", i + 1, gmsh_type(e));
+        for v in written_corners(e) {
+            let _ = write!(s, " {}", v + 1);
+        }
+        s.push('\n');
+    });
+    let first = mesh.elements.len() + 1;
+    for (k, (tag, entity, [a, b])) in lines.iter().enumerate() {
+        let _ = writeln!(s, "{} 1 2 {tag} {entity} {} {}", first + k, a + 1, b + 1);
+    }
+    let _ = writeln!(s, "$EndElements");
+    s
+}
+
+/// Writes `mesh` as Gmsh MSH 2.2 ASCII ([`msh22_string`]), atomically.
+///
+/// # Errors
+/// [`WriteError`] when the mesh is inconsistent or the file cannot be written.
+pub fn write_msh22(path: &Path, mesh: &SegmentedMeshData, frame: &Frame) -> Result<(), WriteError> {
+    check(path, mesh)?;
+    write_atomic(path, msh22_string(mesh, frame).as_bytes())
 }
 
 /// Writes `mesh` as Gmsh MSH 4.1 ASCII, atomically.

@@ -1,4 +1,4 @@
-//! Readers for the meshes `imesh quality` measures: Gmsh MSH 4.1 ASCII and legacy VTK ASCII
+//! Readers for the meshes `imesh quality` measures: Gmsh MSH 4.1 and 2.2 ASCII and legacy VTK ASCII
 //! unstructured grids, keeping their 2D points, triangles and quads (other cells are skipped).
 
 use std::collections::HashMap;
@@ -37,7 +37,7 @@ pub enum ReadError {
         reason: String,
     },
     /// An extension no reader handles.
-    #[error("cannot read {path}: give a .msh (Gmsh 4.1 ASCII) or .vtk (legacy ASCII) mesh")]
+    #[error("cannot read {path}: give a .msh (Gmsh 4.1 or 2.2 ASCII) or .vtk (legacy ASCII) mesh")]
     Unsupported {
         /// The file.
         path: PathBuf,
@@ -119,13 +119,51 @@ impl<'a> Tokens<'a> {
     }
 }
 
+/// The corners an MSH element type has, for the types read (lines and points are skipped).
+fn msh_corners(kind: u32, format: &'static str) -> Result<usize, (&'static str, String)> {
+    match kind {
+        1 => Ok(2),
+        2 => Ok(3),
+        3 => Ok(4),
+        15 => Ok(1),
+        other => Err((format, format!("element type {other} is not read"))),
+    }
+}
+
+/// Reads `corners` node tags into an element (none for a line or a point).
+fn msh_element(
+    t: &mut Tokens<'_>,
+    index: &HashMap<usize, u32>,
+    corners: usize,
+) -> Result<Option<Element>, (&'static str, String)> {
+    let format = t.format;
+    let mut c = [0u32; 4];
+    for slot in c.iter_mut().take(corners) {
+        let (line, tag) = t.next()?;
+        let tag: usize = tag
+            .parse()
+            .map_err(|_| (format, format!("line {line}: {tag:?} is not a node tag")))?;
+        *slot = *index
+            .get(&tag)
+            .ok_or((format, format!("line {line}: no node {tag}")))?;
+    }
+    Ok(match corners {
+        3 => Some(Element::Triangle([c[0], c[1], c[2]])),
+        4 => Some(Element::Quad(c)),
+        _ => None,
+    })
+}
+
 fn parse_msh(text: &str) -> Parsed {
     const F: &str = "Gmsh MSH 4.1";
     let mut t = Tokens::new(text, F);
     t.seek("$MeshFormat")?;
     let (line, version) = t.next()?;
+    if version.starts_with('2') {
+        return parse_msh2(text);
+    }
     if !version.starts_with('4') {
-        return Err((F, format!("line {line}: version {version}, not 4.1")));
+        return Err((F, format!("line {line}: version {version}, not 4.1 or 2.2")));
     }
     if t.number::<u32>()? != 0 {
         return Err((F, "binary files are not read: write it as ASCII".into()));
@@ -155,31 +193,43 @@ fn parse_msh(text: &str) -> Parsed {
     for _ in 0..blocks {
         let (_dim, _entity, kind): (u32, i64, u32) = (t.number()?, t.number()?, t.number()?);
         let n: usize = t.number()?;
-        let corners = match kind {
-            1 => 2,
-            2 => 3,
-            3 => 4,
-            15 => 1,
-            other => return Err((F, format!("element type {other} is not read"))),
-        };
+        let corners = msh_corners(kind, F)?;
         for _ in 0..n {
             let _tag: usize = t.number()?;
-            let mut c = [0u32; 4];
-            for slot in c.iter_mut().take(corners) {
-                let (line, tag) = t.next()?;
-                let tag: usize = tag
-                    .parse()
-                    .map_err(|_| (F, format!("line {line}: {tag:?} is not a node tag")))?;
-                *slot = *index
-                    .get(&tag)
-                    .ok_or((F, format!("line {line}: no node {tag}")))?;
-            }
-            match corners {
-                3 => mesh.elements.push(Element::Triangle([c[0], c[1], c[2]])),
-                4 => mesh.elements.push(Element::Quad(c)),
-                _ => {}
-            }
+            mesh.elements.extend(msh_element(&mut t, &index, corners)?);
         }
+    }
+    Ok(mesh)
+}
+
+/// MSH 2.2 ASCII: one node list, one element list whose lines carry their own tags.
+fn parse_msh2(text: &str) -> Parsed {
+    const F: &str = "Gmsh MSH 2.2";
+    let mut t = Tokens::new(text, F);
+    t.seek("$MeshFormat")?;
+    let _version = t.next()?;
+    if t.number::<u32>()? != 0 {
+        return Err((F, "binary files are not read: write it as ASCII".into()));
+    }
+    t.seek("$Nodes")?;
+    let n: usize = t.number()?;
+    let mut index: HashMap<usize, u32> = HashMap::new();
+    let mut mesh = ReadMesh::default();
+    for _ in 0..n {
+        let tag: usize = t.number()?;
+        let (x, y, _z): (f64, f64, f64) = (t.number()?, t.number()?, t.number()?);
+        index.insert(tag, mesh.vertices.len() as u32);
+        mesh.vertices.push([x, y]);
+    }
+    t.seek("$Elements")?;
+    let m: usize = t.number()?;
+    for _ in 0..m {
+        let (_tag, kind, tags): (usize, u32, usize) = (t.number()?, t.number()?, t.number()?);
+        for _ in 0..tags {
+            let _: i64 = t.number()?;
+        }
+        let corners = msh_corners(kind, F)?;
+        mesh.elements.extend(msh_element(&mut t, &index, corners)?);
     }
     Ok(mesh)
 }
@@ -250,6 +300,11 @@ mod tests {
             m.elements,
             vec![Element::Quad([0, 1, 2, 3]), Element::Triangle([1, 4, 2])]
         );
+        // The same mesh in version 2.2, with a line element (skipped) and tags of any count.
+        let msh2 = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n\
+                    3 1 1 0\n4 0 1 0\n5 2 0 0\n$EndNodes\n$Elements\n3\n1 3 2 1 1 1 2 3 4\n\
+                    2 1 3 5 7 9 1 2\n3 2 0 2 5 3\n$EndElements\n";
+        assert_eq!(parse_msh(msh2).unwrap(), m);
         let vtk =
             "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n\
                    0 0 0 1 0 0 1 1 0 0 1 0\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n9\n";
@@ -260,8 +315,18 @@ mod tests {
 
     #[test]
     fn broken_files_are_clear_errors() {
+        let e = parse_msh("$MeshFormat\n3.0 0 8\n$EndMeshFormat\n").unwrap_err();
+        assert!(e.1.contains("not 4.1 or 2.2"), "{e:?}");
+        // Version 2.2 without its nodes; a header promising more nodes than there are; a
+        // binary file.
         let e = parse_msh("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n").unwrap_err();
-        assert!(e.1.contains("not 4.1"), "{e:?}");
+        assert_eq!(e, ("Gmsh MSH 2.2", "the file ends too early".to_string()));
+        let e =
+            parse_msh("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n99999999999999\n1 0 0 0\n")
+                .unwrap_err();
+        assert!(e.1.contains("ends too early"), "{e:?}");
+        let e = parse_msh("$MeshFormat\n2.2 1 8\n$EndMeshFormat\n").unwrap_err();
+        assert!(e.1.contains("binary"), "{e:?}");
         let e =
             parse_msh("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n2 1 0 1\n1\n0 x 0\n")
                 .unwrap_err();

@@ -1,8 +1,8 @@
 //! The writers: y-up counter-clockwise output, exact areas, atomic failure.
 
 use imesh_io::{
-    boundaries, inp_string, msh_string, vtk_string, vtu_string, write_msh, written_corners, Frame,
-    SegmentedMeshData, OUTSIDE,
+    boundaries, inp_string, msh22_string, msh_string, vtk_string, vtu_string, write_msh,
+    written_corners, Frame, SegmentedMeshData, OUTSIDE,
 };
 use imesh_quality::Element;
 use proptest::prelude::*;
@@ -337,6 +337,120 @@ proptest! {
             .sum();
         prop_assert_eq!(borders, on_sides);
         prop_assert_eq!(on_sides, 2 * (w + h) as usize);
+    }
+}
+
+/// The physical groups of MSH 2.2 text by name: their elements as node lists (lines and
+/// surfaces alike), and the nodes.
+#[allow(clippy::type_complexity)]
+fn msh22_groups(
+    text: &str,
+) -> (
+    std::collections::BTreeMap<String, Vec<Vec<usize>>>,
+    Vec<[f64; 2]>,
+) {
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |tag: &str| lines.iter().position(|l| *l == tag).unwrap();
+    let i = at("$PhysicalNames");
+    let n: usize = lines[i + 1].parse().unwrap();
+    let mut name_of = std::collections::HashMap::new();
+    for l in &lines[i + 2..i + 2 + n] {
+        let (head, name) = l.split_once(" \"").unwrap();
+        let v: Vec<usize> = head.split(' ').map(|x| x.parse().unwrap()).collect();
+        name_of.insert((v[0], v[1]), name.trim_end_matches('"').to_string());
+    }
+    let i = at("$Nodes");
+    let n: usize = lines[i + 1].parse().unwrap();
+    let nodes = lines[i + 2..i + 2 + n]
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            assert_eq!(v[0] as usize, k + 1, "nodes numbered in order");
+            [v[1], v[2]]
+        })
+        .collect();
+    let i = at("$Elements");
+    let m: usize = lines[i + 1].parse().unwrap();
+    let mut groups: std::collections::BTreeMap<String, Vec<Vec<usize>>> = Default::default();
+    for l in &lines[i + 2..i + 2 + m] {
+        let v: Vec<usize> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+        let (kind, tags) = (v[1], v[2]);
+        assert_eq!(tags, 2, "a physical and an elementary tag");
+        let dim = if kind == 1 { 1 } else { 2 };
+        let name = name_of[&(dim, v[3])].clone();
+        groups.entry(name).or_default().push(v[3 + tags..].to_vec());
+    }
+    assert_eq!(lines[i + 2 + m], "$EndElements");
+    (groups, nodes)
+}
+
+proptest! {
+    /// Version 2.2 holds the same nodes and the same physical groups, each of the same
+    /// elements, as version 4.1 (a border line written once per group it belongs to).
+    #[test]
+    fn msh22_has_the_groups_of_msh41(
+        w in 1u32..6, h in 1u32..6, sx in 0.1f64..3.0, ox in -10f64..10.0,
+        seed in proptest::collection::vec(0u32..3, 50),
+    ) {
+        let mut mesh = grid_mesh(w, h);
+        for (k, l) in mesh.labels.iter_mut().enumerate() {
+            *l = seed[k % seed.len()];
+        }
+        mesh.label_names = vec!["a".into(), "b b".into(), "c".into()];
+        mesh.label_colours = vec![[0, 0, 0]; 3];
+        let frame = Frame { pixel_size: [sx, 2.0 * sx], origin: [ox, -ox] };
+        let text = msh22_string(&mesh, &frame);
+        prop_assert!(text.starts_with("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"));
+        let (groups, nodes) = msh22_groups(&text);
+        let four = msh_string(&mesh, &frame);
+        let (nodes4, elements4, _) = parse_msh(&four);
+        prop_assert_eq!(&nodes, &nodes4);
+        // Curves: the same lines per name.
+        let mut curves4 = msh_curves(&four);
+        for lines in curves4.values_mut() {
+            lines.sort_unstable();
+        }
+        let mut curves2: std::collections::BTreeMap<String, Vec<[usize; 2]>> = groups
+            .iter()
+            .filter(|(_, e)| e[0].len() == 2)
+            .map(|(n, e)| (n.clone(), e.iter().map(|l| [l[0], l[1]]).collect()))
+            .collect();
+        for lines in curves2.values_mut() {
+            lines.sort_unstable();
+        }
+        prop_assert_eq!(curves2, curves4);
+        // Surfaces: every element once, in its label's group, its corners as version 4.1 writes
+        // them.
+        let mut want: Vec<(usize, Vec<usize>)> = mesh
+            .elements
+            .iter()
+            .zip(&mesh.labels)
+            .map(|(e, &l)| {
+                let corners: Vec<usize> = written_corners(e).iter().map(|&v| v as usize + 1).collect();
+                (l as usize, corners)
+            })
+            .collect();
+        let mut found: Vec<(usize, Vec<usize>)> = Vec::new();
+        for (name, elements) in groups.iter().filter(|(_, e)| e[0].len() > 2) {
+            let label = mesh.label_names.iter().position(|l| l == name).unwrap();
+            found.extend(elements.iter().map(|e| (label, e.clone())));
+        }
+        want.sort();
+        found.sort();
+        prop_assert_eq!(&found, &want);
+        let mut four: Vec<Vec<usize>> = elements4;
+        four.sort();
+        let mut corners: Vec<Vec<usize>> = found.into_iter().map(|(_, c)| c).collect();
+        corners.sort();
+        prop_assert_eq!(corners, four);
+        // Read back as `imesh quality` reads it: the same elements.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.msh");
+        imesh_io::write_msh22(&path, &mesh, &frame).unwrap();
+        let read = imesh_io::read_mesh(&path).unwrap();
+        prop_assert_eq!(read.vertices, nodes);
+        prop_assert_eq!(read.elements.len(), mesh.elements.len());
     }
 }
 

@@ -11,8 +11,8 @@ use imesh::{
 use imesh_classify::{classify, load_image, Classifier, ClassifyOptions, DEFAULT_MAX_PIXELS};
 use imesh_io::SegmentedMeshData;
 use imesh_io::{
-    read_mesh, svg_string, write_atomic, write_histogram, write_inp, write_msh, write_png,
-    write_svg, write_vtk, write_vtu, Frame, HistogramPanel, SvgOptions,
+    read_mesh, svg_string, write_atomic, write_histogram, write_inp, write_msh, write_msh22,
+    write_png, write_svg, write_vtk, write_vtu, Frame, HistogramPanel, SvgOptions,
 };
 use imesh_quality::{Element, QuadQuality, TriangleQuality};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -43,7 +43,7 @@ enum Command {
     )]
     Classify(ClassifyArgs),
     /// Measure a mesh file's quality with Verdict's metrics (as VTK computes them): Gmsh MSH 4.1 or
-    /// legacy VTK, ASCII.
+    /// 2.2, or legacy VTK, ASCII.
     #[command(after_help = "Example:\n  imesh quality coins.msh --json")]
     Quality(QualityArgs),
     /// Mesh every image of a folder, in parallel; one failure does not stop the others.
@@ -55,8 +55,8 @@ enum Command {
 struct MeshArgs {
     /// The image (PNG, JPEG, TIFF, BMP, ...).
     image: PathBuf,
-    /// Output mesh: .msh (Gmsh 4.1), .vtu (VTK XML), .vtk (legacy VTK) or .inp (Abaqus).
-    /// Default: IMAGE's name with .msh, in the current directory.
+    /// Output mesh: .msh (Gmsh 4.1, or 2.2 with --msh-version), .vtu (VTK XML), .vtk (legacy
+    /// VTK) or .inp (Abaqus). Default: IMAGE's name with .msh, in the current directory.
     #[arg(short, long)]
     output: Option<PathBuf>,
     #[command(flatten)]
@@ -104,6 +104,10 @@ struct BatchArgs {
 /// The mesh options `mesh` and `batch` share.
 #[derive(Args)]
 struct MeshFlags {
+    /// Gmsh file version of a .msh output: 4.1, or 2.2 for readers that know no other (MFEM,
+    /// OpenFOAM's gmshToFoam, older FEniCS tools) [default: 4.1].
+    #[arg(long, value_parser = ["4.1", "2.2"])]
+    msh_version: Option<String>,
     /// Options from a TOML file (command-line options override it).
     #[arg(long)]
     config: Option<PathBuf>,
@@ -364,6 +368,27 @@ fn format_of(output: &Path) -> Result<String, String> {
     }
 }
 
+/// `format` (a name of [`FORMATS`]) as [`write_mesh`] takes it: `msh22` for a .msh output of
+/// version 2.2.
+fn with_msh_version(format: String, version: Option<&str>) -> Result<String, String> {
+    match (format.as_str(), version) {
+        ("msh", Some("2.2")) => Ok("msh22".into()),
+        ("msh", _) | (_, None) => Ok(format),
+        (other, Some(_)) => Err(format!(
+            "--msh-version is for a .msh output, not .{other}: drop it or write a .msh file"
+        )),
+    }
+}
+
+/// The file extension of a [`write_mesh`] format.
+fn extension_of(format: &str) -> &str {
+    if format == "msh22" {
+        "msh"
+    } else {
+        format
+    }
+}
+
 /// Writes the mesh in the format its name says, with the elements' shape as cell data where the
 /// format holds it.
 fn write_mesh(
@@ -389,6 +414,7 @@ fn write_mesh(
     };
     match format {
         "msh" => write_msh(output, mesh, frame).map_err(io),
+        "msh22" => write_msh22(output, mesh, frame).map_err(io),
         "inp" => write_inp(output, mesh, frame).map_err(io),
         "vtk" => write_vtk(output, mesh, frame, &cell_data()).map_err(io),
         _ => write_vtu(output, mesh, frame, &cell_data()).map_err(io),
@@ -528,7 +554,7 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
             PathBuf::from(stem).with_extension("msh")
         }
     };
-    let format = format_of(&output)?;
+    let format = with_msh_version(format_of(&output)?, args.flags.msh_version.as_deref())?;
     // Refuse a missing output folder before the work, not after it.
     for path in [
         Some(&output),
@@ -765,6 +791,7 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
             args.format
         ));
     }
+    let format = with_msh_version(format, args.flags.msh_version.as_deref())?;
     let images = images_in(&args.dir)?;
     if images.is_empty() {
         return Err(format!(
@@ -790,7 +817,10 @@ fn batch(args: &BatchArgs) -> Result<(), String> {
             let PipelineResult {
                 mesh, mut report, ..
             } = pipeline.run_path(image).map_err(|e| e.to_string())?;
-            let output = args.output.join(&stem).with_extension(&format);
+            let output = args
+                .output
+                .join(&stem)
+                .with_extension(extension_of(&format));
             write_timed_mesh(&output, &format, &mesh, &frame, &mut report)?;
             write_report(&args.output.join(format!("{stem}.json")), &report)?;
             Ok(report)

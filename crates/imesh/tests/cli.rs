@@ -464,6 +464,11 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--min-width=-2"], "smallest region width"),
         (&["mesh", image, "--reduction", "0"], "a reduction of 0"),
         (&["mesh", image, "--origin", "5"], "give X,Y"),
+        (&["mesh", image, "--msh-version", "3"], "4.1"),
+        (
+            &["mesh", image, "-o", "m.vtu", "--msh-version", "2.2"],
+            "--msh-version is for a .msh output",
+        ),
         (&["mesh", image, "--origin", "1,inf"], "finite number"),
         (
             &["mesh", image, "--reduction", "half"],
@@ -755,21 +760,26 @@ fn the_histogram_shows_quality_before_and_after_optimisation() {
 fn quality_measures_a_written_mesh_as_the_report_did() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
-    for (name, elements) in [("m.msh", "quad"), ("m.vtk", "tri")] {
-        let out = imesh(
-            &[
-                "mesh",
-                image.to_str().unwrap(),
-                "-o",
-                name,
-                "--elements",
-                elements,
-                "--report",
-                "r.json",
-                "-q",
-            ],
-            dir.path(),
-        );
+    for (name, elements, version) in [
+        ("m.msh", "quad", "4.1"),
+        ("m22.msh", "tri", "2.2"),
+        ("m.vtk", "tri", ""),
+    ] {
+        let mut args = vec![
+            "mesh",
+            image.to_str().unwrap(),
+            "-o",
+            name,
+            "--elements",
+            elements,
+            "--report",
+            "r.json",
+            "-q",
+        ];
+        if !version.is_empty() {
+            args.extend(["--msh-version", version]);
+        }
+        let out = imesh(&args, dir.path());
         assert!(
             out.status.success(),
             "{}",
@@ -814,11 +824,11 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
     }
     std::fs::write(
         dir.path().join("bad.msh"),
-        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n",
+        "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n",
     )
     .unwrap();
     for (file, hint) in [
-        ("bad.msh", "not 4.1"),
+        ("bad.msh", "not 4.1 or 2.2"),
         ("missing.vtk", "cannot read"),
         ("m.json", ".msh"),
     ] {

@@ -40,12 +40,18 @@ fn meshio_reads_every_format_we_write() {
         let image = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../fixtures/images")
             .join(fixture);
-        for (name, pixel) in [
-            ("m.msh", "1"),
-            ("m.vtu", "0.5"),
-            ("m.vtk", "2"),
-            ("m.inp", "1"),
+        for (name, pixel, version) in [
+            ("m.msh", "1", "4.1"),
+            ("m22.msh", "1", "2.2"),
+            ("m.vtu", "0.5", ""),
+            ("m.vtk", "2", ""),
+            ("m.inp", "1", ""),
         ] {
+            let version: &[&str] = if version.is_empty() {
+                &[]
+            } else {
+                &["--msh-version", version]
+            };
             let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
                 .args([
                     "mesh",
@@ -58,6 +64,7 @@ fn meshio_reads_every_format_we_write() {
                     "r.json",
                     "-q",
                 ])
+                .args(version)
                 .current_dir(dir.path())
                 .output()
                 .unwrap();
@@ -158,16 +165,24 @@ fn gmsh_opens_our_msh_with_the_same_physical_groups() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    for fixture in ["stardist-mask2d_labels.png", "skimage-coins.png"] {
+    for (fixture, version) in [
+        ("stardist-mask2d_labels.png", "4.1"),
+        ("skimage-coins.png", "4.1"),
+        ("skimage-coins.png", "2.2"),
+    ] {
+        let fixture_name = fixture;
+        let fixture = format!("{fixture_name} (MSH {version})");
         let image = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../fixtures/images")
-            .join(fixture);
+            .join(fixture_name);
         let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
             .args([
                 "mesh",
                 image.to_str().unwrap(),
                 "-o",
                 "m.msh",
+                "--msh-version",
+                version,
                 "--report",
                 "r.json",
                 "-q",
