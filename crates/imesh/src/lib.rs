@@ -696,6 +696,25 @@ pub struct Fidelity {
     /// boundary chain it replaces (pixels); the triangle mesh's boundaries are the chains
     /// themselves (0).
     pub boundary_hausdorff_px: f64,
+    /// Each label with a pixel in the image: how much of it the mesh holds (its area fraction against the
+    /// image's, for a phase fraction), and how faithfully.
+    pub regions: Vec<RegionFidelity>,
+}
+
+/// How one label of the image comes out in the mesh.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RegionFidelity {
+    /// The label's name.
+    pub name: String,
+    /// Its pixels in the image.
+    pub pixels: u64,
+    /// The area of the mesh's elements of this label, in square pixels (compare with
+    /// `pixels`).
+    pub area_px: f64,
+    /// How many elements carry it.
+    pub elements: usize,
+    /// The share of its pixels whose centre lies in an element of this label.
+    pub agreement: f64,
 }
 
 /// What the quad path adds to the report.
@@ -1032,7 +1051,7 @@ impl Pipeline {
         );
         report.validation.area_ratio = area_ratio?;
         report.quality = quality;
-        report.label_agreement = label_agreement;
+        (report.label_agreement, report.fidelity.regions) = label_agreement;
         report.fidelity.label_agreement = report.label_agreement;
         report.seconds.check += check.elapsed().as_secs_f64();
         Ok(())
@@ -1199,7 +1218,7 @@ impl Pipeline {
                     // disagreement.
                     || match &cleaned {
                         Some(_) => agreement_with_original(&mesh, original),
-                        None => label_agreement(&mesh, grid),
+                        None => region_fidelity(&mesh, grid),
                     },
                 )
             },
@@ -1220,10 +1239,11 @@ impl Pipeline {
                 width: w,
                 height: h,
             },
-            label_agreement,
+            label_agreement: label_agreement.0,
             fidelity: Fidelity {
-                label_agreement,
+                label_agreement: label_agreement.0,
                 boundary_hausdorff_px: optimised.as_ref().map_or(0.0, |x| x.hausdorff),
+                regions: label_agreement.1,
             },
             quality,
             sharpest_boundary_corner,
@@ -2051,6 +2071,33 @@ fn equilateral_area(s: f64) -> f64 {
 /// between two elements, either counts). Elements are convex (positive Jacobian at every corner),
 /// so a centre is inside when it is on the inner side of every edge.
 pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
+    region_fidelity(mesh, grid).0
+}
+
+/// [`label_agreement`], and how each label of `grid` comes out in `mesh` (whose labels are
+/// `grid`'s): its pixels, the area of its elements, their count and its own agreement.
+///
+/// ```
+/// use imesh::region_fidelity;
+/// use imesh_classify::{LabelGrid, Region};
+/// use imesh_io::SegmentedMeshData;
+/// use imesh_quality::Element;
+/// // A 2 × 1 image of two labels, meshed as one quad per pixel.
+/// let region = |name: &str| Region { name: name.into(), colour: [0; 3] };
+/// let grid = LabelGrid::new(2, 1, vec![0, 1], vec![region("pore"), region("grain")]).unwrap();
+/// let mesh = SegmentedMeshData {
+///     vertices: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0], [1.0, 1.0], [2.0, 1.0]],
+///     elements: vec![Element::Quad([0, 1, 4, 3]), Element::Quad([1, 2, 5, 4])],
+///     labels: vec![0, 0], // the second pixel meshed with the first's label
+///     label_names: grid.regions().iter().map(|r| r.name.clone()).collect(),
+///     label_colours: vec![[0; 3]; 2], width: 2, height: 1,
+/// };
+/// let (agreement, regions) = region_fidelity(&mesh, &grid);
+/// assert_eq!(agreement, 0.5);
+/// assert_eq!((regions[0].pixels, regions[0].area_px, regions[0].agreement), (1, 2.0, 1.0));
+/// assert_eq!((regions[1].pixels, regions[1].elements, regions[1].agreement), (1, 0, 0.0));
+/// ```
+pub fn region_fidelity(mesh: &SegmentedMeshData, grid: &LabelGrid) -> (f64, Vec<RegionFidelity>) {
     agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid)
 }
 
@@ -2100,7 +2147,10 @@ fn sharpest_boundary_corner(mesh: &SegmentedMeshData) -> Option<BoundaryCorner> 
 
 /// [`label_agreement`] of a mesh whose labels name the regions of another grid (a cleaned or
 /// reduced one, whose regions are a subset of `original`'s) against `original`, region by name.
-fn agreement_with_original(mesh: &SegmentedMeshData, original: &LabelGrid) -> f64 {
+fn agreement_with_original(
+    mesh: &SegmentedMeshData,
+    original: &LabelGrid,
+) -> (f64, Vec<RegionFidelity>) {
     let id: std::collections::HashMap<&str, u32> = original
         .regions()
         .iter()
@@ -2121,11 +2171,42 @@ fn agreement_with_original(mesh: &SegmentedMeshData, original: &LabelGrid) -> f6
     agreement(&mesh.vertices, &mesh.elements, &labels, original)
 }
 
-/// [`label_agreement`] of elements with their own labels (numbered as `grid`'s).
-fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: &LabelGrid) -> f64 {
+/// [`label_agreement`] of elements with their own labels (numbered as `grid`'s, [`u32::MAX`]
+/// for none of them), and each of `grid`'s labels' [`RegionFidelity`].
+fn agreement(
+    vertices: &[[f64; 2]],
+    elements: &[Element],
+    labels: &[u32],
+    grid: &LabelGrid,
+) -> (f64, Vec<RegionFidelity>) {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let mut regions: Vec<RegionFidelity> = grid
+        .regions()
+        .iter()
+        .map(|r| RegionFidelity {
+            name: r.name.clone(),
+            pixels: 0,
+            area_px: 0.0,
+            elements: 0,
+            agreement: 1.0,
+        })
+        .collect();
+    for (element, &label) in elements.iter().zip(labels) {
+        if let Some(region) = regions.get_mut(label as usize) {
+            region.elements += 1;
+            let c = element.corners();
+            let n = c.len();
+            region.area_px += (0..n)
+                .map(|i| {
+                    let (a, b) = (vertices[c[i] as usize], vertices[c[(i + 1) % n] as usize]);
+                    a[0] * b[1] - a[1] * b[0]
+                })
+                .sum::<f64>()
+                / 2.0;
+        }
+    }
     if w == 0 || h == 0 {
-        return 1.0;
+        return (1.0, regions);
     }
     // Each element marks its pixel centres of its own label, element by element in parallel
     // (a centre on an edge shared by two elements may be marked twice).
@@ -2169,8 +2250,22 @@ fn agreement(vertices: &[[f64; 2]], elements: &[Element], labels: &[u32], grid: 
                 }
             }
         });
-    let agreeing = agrees.iter().filter(|a| a.load(Ordering::Relaxed)).count();
-    agreeing as f64 / (w * h) as f64
+    let mut agreeing_in = vec![0u64; regions.len()];
+    for (&label, agrees) in grid.labels().iter().zip(&agrees) {
+        if let Some(region) = regions.get_mut(label as usize) {
+            region.pixels += 1;
+            agreeing_in[label as usize] += u64::from(agrees.load(Ordering::Relaxed));
+        }
+    }
+    for (region, &agreeing) in regions.iter_mut().zip(&agreeing_in) {
+        if region.pixels > 0 {
+            region.agreement = agreeing as f64 / region.pixels as f64;
+        }
+    }
+    let agreeing: u64 = agreeing_in.iter().sum();
+    // A label of the grid's with no pixel (an empty class) says nothing.
+    regions.retain(|g| g.pixels > 0 || g.elements > 0);
+    (agreeing as f64 / (w * h) as f64, regions)
 }
 
 #[cfg(test)]

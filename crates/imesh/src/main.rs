@@ -706,7 +706,7 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
                 c.blunted_area_px
             );
         }
-        for note in clean_up_notes(c, report.label_agreement) {
+        for note in clean_up_notes(c, &report.fidelity) {
             println!("{note}");
         }
         if c.reduction > 1 {
@@ -724,9 +724,13 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
 /// Label agreement under which the command says how much the clean-up relabelled.
 const LOW_AGREEMENT: f64 = 0.9;
 
+/// Share of a label's pixels under which the area of its elements is worth a note.
+const LOW_AREA: f64 = 0.5;
+
 /// What the clean-up cost, when a user would want to know: labels of the image that no element
-/// carries, and a label agreement under [`LOW_AGREEMENT`].
-fn clean_up_notes(c: &imesh::Counts, label_agreement: f64) -> Vec<String> {
+/// carries, labels whose elements cover under [`LOW_AREA`] of their pixels' area (a phase
+/// fraction the mesh does not keep), and a label agreement under [`LOW_AGREEMENT`].
+fn clean_up_notes(c: &imesh::Counts, fidelity: &imesh::Fidelity) -> Vec<String> {
     let quads = if c.quad_size > 0.0 {
         format!("the {:.1} px quads", c.quad_size)
     } else {
@@ -750,7 +754,37 @@ fn clean_up_notes(c: &imesh::Counts, label_agreement: f64) -> Vec<String> {
             c.image_labels
         ));
     }
+    let shrunk: Vec<&imesh::RegionFidelity> = fidelity
+        .regions
+        .iter()
+        .filter(|g| g.elements > 0 && g.area_px < LOW_AREA * g.pixels as f64)
+        .collect();
+    if !shrunk.is_empty() {
+        let named: Vec<String> = shrunk
+            .iter()
+            .take(3)
+            .map(|g| {
+                format!(
+                    "{} ({:.0} % of its {} px)",
+                    g.name,
+                    100.0 * g.area_px / g.pixels as f64,
+                    g.pixels
+                )
+            })
+            .collect();
+        let more = if shrunk.len() > 3 { ", ..." } else { "" };
+        let (count, keeps) = if shrunk.len() == 1 {
+            ("1 label keeps".to_string(), "its")
+        } else {
+            (format!("{} labels keep", shrunk.len()), "their")
+        };
+        notes.push(format!(
+            "{count} under half {keeps} area in the mesh: {}{more}; most of {keeps} regions were thinner or smaller than {quads} can follow ({keep}; the report's fidelity.regions lists every label)",
+            named.join(", ")
+        ));
+    }
     let pixels = f64::from(c.grid_width) * f64::from(c.grid_height);
+    let label_agreement = fidelity.label_agreement;
     if label_agreement < LOW_AGREEMENT && c.cleaned_pixels > 0 && pixels > 0.0 {
         notes.push(format!(
             "label agreement is under {:.0} %: the clean-up relabelled {:.1} % of the pixels, specks, notches and strips thinner than {quads} can follow ({keep})",

@@ -97,6 +97,32 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     let msh = std::fs::read_to_string(dir.path().join("pyvista-channels_z050_labels.msh")).unwrap();
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("m.json")).unwrap()).unwrap();
+    // The labels whose thin channels the clean-up merged away are named, with the share of
+    // their area the mesh keeps, as the report's regions have it.
+    let said = String::from_utf8_lossy(&out.stdout);
+    let regions = report["fidelity"]["regions"].as_array().unwrap();
+    assert_eq!(regions.len(), 5);
+    let shrunk: Vec<&serde_json::Value> = regions
+        .iter()
+        .filter(|g| g["area_px"].as_f64().unwrap() < 0.5 * g["pixels"].as_f64().unwrap())
+        .collect();
+    assert!(!shrunk.is_empty(), "{regions:?}");
+    assert!(
+        said.contains(&format!(
+            "keep{} under half",
+            if shrunk.len() == 1 { "s" } else { "" }
+        )),
+        "{said}"
+    );
+    for g in shrunk {
+        let share = 100.0 * g["area_px"].as_f64().unwrap() / g["pixels"].as_f64().unwrap();
+        let named = format!(
+            "{} ({share:.0} % of its {} px)",
+            g["name"].as_str().unwrap(),
+            g["pixels"]
+        );
+        assert!(said.contains(&named), "{named}: {said}");
+    }
     let (nodes, elements, names, curves) = msh_counts(&msh);
     assert_eq!(nodes as u64, report["counts"]["vertices"].as_u64().unwrap());
     assert_eq!(

@@ -49,6 +49,7 @@ fn degenerate_images_give_valid_all_quad_meshes() {
             assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "{name}");
             assert_eq!(r.counts.triangles, 0, "{name}: all quads");
             assert!(r.counts.quads > 0, "{name}");
+            check_regions(r, name);
             assert!(
                 r.quality.scaled_jacobian().min > 0.0,
                 "{name}: an inverted quad"
@@ -73,6 +74,7 @@ fn the_triangle_path_stays_available() {
             assert!(r.validation.valid, "{name}");
             assert!((r.validation.area_ratio - 1.0).abs() < 1e-9, "{name}");
             assert_eq!(r.counts.quads, 0, "{name}");
+            check_regions(r, name);
             // A reduction only where the image spans more than a cell.
             let expected = match reduction {
                 Some(f) if r.counts.width.max(r.counts.height) > 1 => f,
@@ -82,6 +84,35 @@ fn the_triangle_path_stays_available() {
             let cells = |n: u32| (n + expected / 2) / expected;
             assert_eq!(r.counts.grid_width, cells(r.counts.width).max(1), "{name}");
         }
+    }
+}
+
+/// The report's regions: one per label of the image, their pixels the image's, their element
+/// areas the mesh's (the whole domain between them), and their agreements the whole one's.
+fn check_regions(r: &imesh::Report, what: &str) {
+    let regions = &r.fidelity.regions;
+    assert_eq!(regions.len(), r.counts.image_labels, "{what}");
+    let area = f64::from(r.input.width) * f64::from(r.input.height);
+    let pixels: u64 = regions.iter().map(|g| g.pixels).sum();
+    assert_eq!(pixels as f64, area, "{what}");
+    let meshed: f64 = regions.iter().map(|g| g.area_px).sum();
+    assert!(
+        (meshed / area - 1.0).abs() < 1e-9,
+        "{what}: {meshed} of {area}"
+    );
+    let elements: usize = regions.iter().map(|g| g.elements).sum();
+    assert_eq!(elements, r.counts.elements, "{what}");
+    let agreeing: f64 = regions.iter().map(|g| g.agreement * g.pixels as f64).sum();
+    assert!(
+        (agreeing / area - r.label_agreement).abs() < 1e-9,
+        "{what}: {} against {}",
+        agreeing / area,
+        r.label_agreement
+    );
+    for g in regions {
+        assert!((0.0..=1.0).contains(&g.agreement), "{what}: {g:?}");
+        assert_eq!(g.elements == 0, g.area_px == 0.0, "{what}: {g:?}");
+        assert!(g.area_px >= 0.0, "{what}: {g:?}");
     }
 }
 
@@ -97,6 +128,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         let r = &quads.report;
         // The pipeline refuses to return a mesh that fails the validator; check it said so.
         assert!(r.validation.valid, "{}", path.display());
+        check_regions(r, &path.display().to_string());
         assert!(
             (r.validation.area_ratio - 1.0).abs() < 1e-9,
             "{}",
@@ -402,6 +434,8 @@ fn a_large_image_is_meshed_on_a_reduced_grid_and_scaled_back() {
     );
     // Scaled back exactly onto the image: its corners and border, the whole area.
     assert!(reduced.validation.valid);
+    check_regions(&reduced, "reduced");
+    check_regions(&pixels, "pixels");
     assert!((reduced.validation.area_ratio - 1.0).abs() < 1e-9);
     for corner in [[0.0, 0.0], [1300.0, 0.0], [1300.0, 1100.0], [0.0, 1100.0]] {
         assert!(mesh.vertices.contains(&corner), "corner {corner:?}");
