@@ -237,23 +237,26 @@ proptest! {
     }
 }
 
+/// The `$PhysicalNames` of MSH text (either version) by dimension and tag.
+fn physical_names(lines: &[&str]) -> std::collections::HashMap<(usize, usize), String> {
+    let i = lines.iter().position(|l| *l == "$PhysicalNames").unwrap();
+    let n: usize = lines[i + 1].parse().unwrap();
+    lines[i + 2..i + 2 + n]
+        .iter()
+        .map(|l| {
+            let (head, name) = l.split_once(" \"").unwrap();
+            let v: Vec<usize> = head.split(' ').map(|x| x.parse().unwrap()).collect();
+            ((v[0], v[1]), name.trim_end_matches('"').to_string())
+        })
+        .collect()
+}
+
 /// The line elements of each named physical curve of MSH 4.1 text, as node pairs (an entity's
 /// lines belong to every physical curve it carries).
 fn msh_curves(text: &str) -> std::collections::BTreeMap<String, Vec<[usize; 2]>> {
     let lines: Vec<&str> = text.lines().collect();
     let at = |tag: &str| lines.iter().position(|l| *l == tag).unwrap();
-    let i = at("$PhysicalNames");
-    let n: usize = lines[i + 1].parse().unwrap();
-    let mut name_of = std::collections::HashMap::new();
-    for l in &lines[i + 2..i + 2 + n] {
-        let (head, name) = l.split_once(" \"").unwrap();
-        if let Some(tag) = head.strip_prefix("1 ") {
-            name_of.insert(
-                tag.parse::<usize>().unwrap(),
-                name.trim_end_matches('"').to_string(),
-            );
-        }
-    }
+    let names = physical_names(&lines);
     let i = at("$Entities");
     let curves: usize = lines[i + 1].split(' ').nth(1).unwrap().parse().unwrap();
     let mut physical_of = std::collections::HashMap::new();
@@ -273,7 +276,7 @@ fn msh_curves(text: &str) -> std::collections::BTreeMap<String, Vec<[usize; 2]>>
             for l in &lines[k + 1..k + 1 + count] {
                 let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
                 for tag in &physical_of[&head[1]] {
-                    out.entry(name_of[tag].clone())
+                    out.entry(names[&(1, *tag)].clone())
                         .or_default()
                         .push([v[0], v[1]]);
                 }
@@ -351,14 +354,7 @@ fn msh22_groups(
 ) {
     let lines: Vec<&str> = text.lines().collect();
     let at = |tag: &str| lines.iter().position(|l| *l == tag).unwrap();
-    let i = at("$PhysicalNames");
-    let n: usize = lines[i + 1].parse().unwrap();
-    let mut name_of = std::collections::HashMap::new();
-    for l in &lines[i + 2..i + 2 + n] {
-        let (head, name) = l.split_once(" \"").unwrap();
-        let v: Vec<usize> = head.split(' ').map(|x| x.parse().unwrap()).collect();
-        name_of.insert((v[0], v[1]), name.trim_end_matches('"').to_string());
-    }
+    let name_of = physical_names(&lines);
     let i = at("$Nodes");
     let n: usize = lines[i + 1].parse().unwrap();
     let nodes = lines[i + 2..i + 2 + n]

@@ -17,6 +17,17 @@ fn imesh(args: &[&str], dir: &Path) -> Output {
         .expect("the imesh binary runs")
 }
 
+/// [`imesh`], which must succeed (its stderr shown if not).
+fn imesh_ok(args: &[&str], dir: &Path) -> Output {
+    let out = imesh(args, dir);
+    assert!(
+        out.status.success(),
+        "imesh {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// The counts of an MSH 4.1 file: nodes, surface elements, physical surfaces, physical curves.
 fn msh_counts(text: &str) -> (usize, usize, usize, usize) {
     let lines: Vec<&str> = text.lines().collect();
@@ -69,7 +80,7 @@ fn save_square(path: &Path, side: std::ops::Range<u32>) {
 fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("pyvista-channels_z050_labels.png");
-    let out = imesh(
+    let out = imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -81,11 +92,6 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
             "m.png",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     // No progress bar when stderr is not a terminal (here a pipe): stderr stays clean.
     assert!(
@@ -227,7 +233,7 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
 fn vtu_output_and_options() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
-    let out = imesh(
+    let out = imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -243,11 +249,6 @@ fn vtu_output_and_options() {
         ],
         dir.path(),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(out.stdout.is_empty(), "--quiet prints nothing");
     let vtu = std::fs::read_to_string(dir.path().join("coins.vtu")).unwrap();
     assert!(vtu.contains("Name=\"label\"") && vtu.contains("Name=\"shape\""));
@@ -257,7 +258,7 @@ fn vtu_output_and_options() {
 fn pixel_size_and_origin_place_the_image_in_the_written_frame() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("pyvista-channels_z050_labels.png"); // 250 × 250 px
-    let out = imesh(
+    imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -272,11 +273,6 @@ fn pixel_size_and_origin_place_the_image_in_the_written_frame() {
             "-q",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let msh = std::fs::read_to_string(dir.path().join("m.msh")).unwrap();
     let lines: Vec<&str> = msh.lines().collect();
@@ -305,14 +301,9 @@ fn abaqus_and_legacy_vtk_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("pyvista-channels_z050_labels.png");
     for name in ["m.inp", "m.vtk"] {
-        let out = imesh(
+        imesh_ok(
             &["mesh", image.to_str().unwrap(), "-o", name, "-q"],
             dir.path(),
-        );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
         );
     }
     let inp = std::fs::read_to_string(dir.path().join("m.inp")).unwrap();
@@ -342,12 +333,7 @@ fn the_triangle_mesh_and_quad_options() {
     let run = |extra: &[&str], report: &str| {
         let mut args = vec!["mesh", image, "-o", "m.inp", "-q", "--report", report];
         args.extend_from_slice(extra);
-        let out = imesh(&args, dir.path());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        imesh_ok(&args, dir.path());
         let text = std::fs::read_to_string(dir.path().join(report)).unwrap();
         serde_json::from_str::<serde_json::Value>(&text).unwrap()
     };
@@ -628,7 +614,7 @@ fn a_config_file_sets_options_and_unknown_keys_are_refused() {
     let image = fixture("matplotlib-s1045_mri.png");
     std::fs::write(dir.path().join("good.toml"), "te = 0.3\nmin_angle = 22.0\n").unwrap();
     std::fs::write(dir.path().join("bad.toml"), "tee = 0.3\n").unwrap();
-    let out = imesh(
+    imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -639,11 +625,6 @@ fn a_config_file_sets_options_and_unknown_keys_are_refused() {
             "-q",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
@@ -661,7 +642,7 @@ fn a_config_file_sets_options_and_unknown_keys_are_refused() {
 fn classify_writes_a_label_image() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coffee.png");
-    let out = imesh(
+    let out = imesh_ok(
         &[
             "classify",
             image.to_str().unwrap(),
@@ -671,11 +652,6 @@ fn classify_writes_a_label_image() {
             "labels.png",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("3 labels"));
     assert!(dir.path().join("labels.png").exists());
@@ -725,12 +701,7 @@ fn batch_meshes_a_folder_and_reports_failures_without_stopping() {
     }
     // All good: exit code 0.
     std::fs::remove_file(input.join("broken.png")).unwrap();
-    let out = imesh(&["batch", "in", "-o", "out2"], dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    imesh_ok(&["batch", "in", "-o", "out2"], dir.path());
     assert!(dir.path().join("out2/matplotlib-s1045_mri.msh").exists());
 }
 
@@ -738,7 +709,7 @@ fn batch_meshes_a_folder_and_reports_failures_without_stopping() {
 fn the_histogram_shows_quality_before_and_after_optimisation() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("stardist-mask2d_labels.png");
-    let out = imesh(
+    imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -751,11 +722,6 @@ fn the_histogram_shows_quality_before_and_after_optimisation() {
             "-q",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let picture = image::open(dir.path().join("h.png")).unwrap().to_rgb8();
     assert_eq!(picture.dimensions(), (520, 520), "two panels");
@@ -805,21 +771,11 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
         if !version.is_empty() {
             args.extend(["--msh-version", version]);
         }
-        let out = imesh(&args, dir.path());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        imesh_ok(&args, dir.path());
         let report: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
                 .unwrap();
-        let out = imesh(&["quality", name, "--json"], dir.path());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = imesh_ok(&["quality", name, "--json"], dir.path());
         let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(measured["vertices"], report["counts"]["vertices"], "{name}");
         assert_eq!(measured["quads"], report["counts"]["quads"], "{name}");
@@ -871,7 +827,7 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
 fn stages_draws_every_step_of_the_pipeline() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("stardist-mask2d_labels.png");
-    let out = imesh(
+    imesh_ok(
         &[
             "mesh",
             image.to_str().unwrap(),
@@ -884,11 +840,6 @@ fn stages_draws_every_step_of_the_pipeline() {
             "-q",
         ],
         dir.path(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
