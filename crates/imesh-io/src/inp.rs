@@ -56,10 +56,8 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let curves = boundaries(mesh);
     let node_set = |s: &mut String, name: &str, vertices: &[u32]| {
         let _ = writeln!(s, "*Nset, nset={name}");
-        for chunk in vertices.chunks(16) {
-            let ids: Vec<String> = chunk.iter().map(|v| (v + 1).to_string()).collect();
-            let _ = writeln!(s, "{}", ids.join(", "));
-        }
+        let ids: Vec<usize> = vertices.iter().map(|&v| v as usize + 1).collect();
+        write_ids(s, &ids);
     };
     for b in &curves {
         node_set(&mut s, &b.name(mesh), &b.vertices());
@@ -89,10 +87,7 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
                 continue;
             }
             let _ = writeln!(s, "*Elset, elset={}_S{}", side.name(), face + 1);
-            for chunk in elements.chunks(16) {
-                let ids: Vec<String> = chunk.iter().map(|e| e.to_string()).collect();
-                let _ = writeln!(s, "{}", ids.join(", "));
-            }
+            write_ids(&mut s, elements);
         }
         let _ = writeln!(s, "*Surface, type=ELEMENT, name={}_surface", side.name());
         for (face, elements) in by_face.iter().enumerate() {
@@ -102,6 +97,14 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         }
     }
     s
+}
+
+/// Writes `ids` sixteen to a line (the most an Abaqus data line holds).
+fn write_ids(s: &mut String, ids: &[usize]) {
+    for chunk in ids.chunks(16) {
+        let line: Vec<String> = chunk.iter().map(|id| id.to_string()).collect();
+        let _ = writeln!(s, "{}", line.join(", "));
+    }
 }
 
 /// Per side of the domain (its border edges `sides`, [`Side::ALL`] order), the elements with a

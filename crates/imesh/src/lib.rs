@@ -2194,15 +2194,12 @@ fn agreement(
     for (element, &label) in elements.iter().zip(labels) {
         if let Some(region) = regions.get_mut(label as usize) {
             region.elements += 1;
-            let c = element.corners();
-            let n = c.len();
-            region.area_px += (0..n)
-                .map(|i| {
-                    let (a, b) = (vertices[c[i] as usize], vertices[c[(i + 1) % n] as usize]);
-                    a[0] * b[1] - a[1] * b[0]
-                })
-                .sum::<f64>()
-                / 2.0;
+            let corners: Vec<[f64; 2]> = element
+                .corners()
+                .iter()
+                .map(|&v| vertices[v as usize])
+                .collect();
+            region.area_px += imesh_quality::signed_area(&corners);
         }
     }
     if w == 0 || h == 0 {

@@ -220,32 +220,28 @@ struct ClassifyArgs {
     output: PathBuf,
 }
 
+/// A finite number of a comma-separated option.
+fn finite_number(p: &str) -> Result<f64, String> {
+    match p.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("{p:?} is not a finite number")),
+    }
+}
+
 fn parse_pixel_size(s: &str) -> Result<[f64; 2], String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let parse = |p: &str| {
-        p.trim()
-            .parse::<f64>()
-            .map_err(|_| format!("{p:?} is not a number"))
-    };
-    match parts.as_slice() {
+    match s.split(',').collect::<Vec<_>>().as_slice() {
         [x] => {
-            let x = parse(x)?;
+            let x = finite_number(x)?;
             Ok([x, x])
         }
-        [x, y] => Ok([parse(x)?, parse(y)?]),
+        [x, y] => Ok([finite_number(x)?, finite_number(y)?]),
         _ => Err("give SX or SX,SY".into()),
     }
 }
 
 fn parse_origin(s: &str) -> Result<[f64; 2], String> {
     match s.split(',').collect::<Vec<_>>().as_slice() {
-        [x, y] => {
-            let parse = |p: &str| match p.trim().parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(format!("{p:?} is not a finite number")),
-            };
-            Ok([parse(x)?, parse(y)?])
-        }
+        [x, y] => Ok([finite_number(x)?, finite_number(y)?]),
         _ => Err("give X,Y".into()),
     }
 }
