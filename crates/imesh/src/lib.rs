@@ -2171,6 +2171,9 @@ fn agreement_with_original(
     agreement(&mesh.vertices, &mesh.elements, &labels, original)
 }
 
+/// Pixels counted per parallel task by [`agreement`].
+const COUNT_CHUNK: usize = 1 << 16;
+
 /// [`label_agreement`] of elements with their own labels (numbered as `grid`'s, [`u32::MAX`]
 /// for none of them), and each of `grid`'s labels' [`RegionFidelity`].
 fn agreement(
@@ -2247,19 +2250,39 @@ fn agreement(
                 }
             }
         });
-    let mut agreeing_in = vec![0u64; regions.len()];
-    for (&label, agrees) in grid.labels().iter().zip(&agrees) {
-        if let Some(region) = regions.get_mut(label as usize) {
-            region.pixels += 1;
-            agreeing_in[label as usize] += u64::from(agrees.load(Ordering::Relaxed));
+    // Per label, its pixels and those agreeing, counted over parts of the image in parallel.
+    let labels = regions.len();
+    let tally = |mut counts: Vec<[u64; 2]>, (grid_labels, agrees): (&[u32], &[AtomicBool])| {
+        for (&label, agrees) in grid_labels.iter().zip(agrees) {
+            if let Some(c) = counts.get_mut(label as usize) {
+                c[0] += 1;
+                c[1] += u64::from(agrees.load(Ordering::Relaxed));
+            }
+        }
+        counts
+    };
+    let counts = grid
+        .labels()
+        .par_chunks(COUNT_CHUNK)
+        .zip(agrees.par_chunks(COUNT_CHUNK))
+        .fold(|| vec![[0u64; 2]; labels], tally)
+        .reduce(
+            || vec![[0u64; 2]; labels],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    x[0] += y[0];
+                    x[1] += y[1];
+                }
+                a
+            },
+        );
+    for (region, &[pixels, agreeing]) in regions.iter_mut().zip(&counts) {
+        region.pixels = pixels;
+        if pixels > 0 {
+            region.agreement = agreeing as f64 / pixels as f64;
         }
     }
-    for (region, &agreeing) in regions.iter_mut().zip(&agreeing_in) {
-        if region.pixels > 0 {
-            region.agreement = agreeing as f64 / region.pixels as f64;
-        }
-    }
-    let agreeing: u64 = agreeing_in.iter().sum();
+    let agreeing: u64 = counts.iter().map(|c| c[1]).sum();
     // A label of the grid's with no pixel (an empty class) says nothing.
     regions.retain(|g| g.pixels > 0 || g.elements > 0);
     (agreeing as f64 / (w * h) as f64, regions)
