@@ -13,11 +13,12 @@ use crate::{
 
 /// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
 /// each on its own surface entity carrying the physical surface `label + 1` named after the
-/// label, then the boundary edges as lines: a named physical curve per boundary (between two
-/// labels, or between a label and the domain border, tags from 1), and one per side of the
-/// domain (`left`, `right`, `bottom`, `top`, tags after the boundaries', in that order), for
-/// boundary conditions. A boundary between labels is one curve entity; a label's border is one
-/// per side it runs along, each in both its physical curves.
+/// label, then the boundary edges as lines: a named physical curve per side of the domain
+/// (`left`, `right`, `bottom`, `top`: tags 1 to 4), for boundary conditions, and one per
+/// boundary (between two labels, or between a label and the domain border, tags from 5). A
+/// boundary between labels is one curve entity; a label's border is one per side it runs along,
+/// in both its physical curves, the side's first and with the smaller tag: a reader that keeps
+/// one group per line (meshio's `gmsh:physical` keeps the first) keeps the side.
 pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut s = String::new();
     // Writing to a String cannot fail; the results are ignored on purpose.
@@ -34,7 +35,7 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             .map(|&v| mapped[v as usize])
             .collect();
         let (clo, chi) = bounds(&ends);
-        let tags = groups.physical_tags(*i, *side);
+        let tags = Groups::physical_tags(*i, *side);
         let physical: Vec<String> = tags.iter().map(|t| t.to_string()).collect();
         let physical = format!("{} {}", tags.len(), physical.join(" "));
         let _ = writeln!(
@@ -118,11 +119,12 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
 struct Groups {
     /// The labels the elements carry (a physical surface each, tag `label + 1`).
     used: Vec<u32>,
-    /// The boundaries (a physical curve each, tags from 1).
+    /// The boundaries (a physical curve each, tags after the sides').
     curves: Vec<Boundary>,
     /// The curve entities: its boundary, its side of the domain if on the border, its edges.
     entities: Vec<(usize, Option<Side>, Vec<[u32; 2]>)>,
-    /// The sides of the domain with edges (a physical curve each, after the boundaries').
+    /// The sides of the domain with edges (a physical curve each, tags 1 to 4 in
+    /// [`Side::ALL`] order).
     sides: Vec<Side>,
 }
 
@@ -156,15 +158,21 @@ impl Groups {
     }
 
     /// The physical curve of `side`.
-    fn side_tag(&self, side: Side) -> usize {
-        self.curves.len() + 1 + side as usize
+    fn side_tag(side: Side) -> usize {
+        1 + side as usize
     }
 
-    /// The physical curves of an entity of boundary `boundary` along `side`: the boundary's,
-    /// then the side's.
-    fn physical_tags(&self, boundary: usize, side: Option<Side>) -> Vec<usize> {
-        std::iter::once(boundary + 1)
-            .chain(side.map(|side| self.side_tag(side)))
+    /// The physical curve of boundary `boundary`.
+    fn boundary_tag(boundary: usize) -> usize {
+        1 + Side::ALL.len() + boundary
+    }
+
+    /// The physical curves of an entity of boundary `boundary` along `side`: the side's, then
+    /// the boundary's.
+    fn physical_tags(boundary: usize, side: Option<Side>) -> Vec<usize> {
+        side.map(Self::side_tag)
+            .into_iter()
+            .chain([Self::boundary_tag(boundary)])
             .collect()
     }
 
@@ -172,11 +180,11 @@ impl Groups {
     fn write_names(&self, mesh: &SegmentedMeshData, s: &mut String) {
         let count = self.used.len() + self.curves.len() + self.sides.len();
         let _ = writeln!(s, "$PhysicalNames\n{count}");
-        for (i, b) in self.curves.iter().enumerate() {
-            let _ = writeln!(s, "1 {} \"{}\"", i + 1, b.name(mesh));
-        }
         for &side in &self.sides {
-            let _ = writeln!(s, "1 {} \"{}\"", self.side_tag(side), side.name());
+            let _ = writeln!(s, "1 {} \"{}\"", Self::side_tag(side), side.name());
+        }
+        for (i, b) in self.curves.iter().enumerate() {
+            let _ = writeln!(s, "1 {} \"{}\"", Self::boundary_tag(i), b.name(mesh));
         }
         for &l in &self.used {
             let name = mesh.label_names[l as usize].replace('"', "'");
@@ -190,7 +198,7 @@ impl Groups {
 /// older FEniCS tools): the same physical groups as [`msh_string`], each element tagged with
 /// its physical group and its entity (a label's surface, or its [`msh_string`] curve entity).
 /// Version 2 gives an element one physical group, so a border line is written once for its
-/// label's border and once again for its side of the domain, as Gmsh itself writes an element
+/// side of the domain and once again for its label's border, as Gmsh itself writes an element
 /// of two groups.
 ///
 /// ```
@@ -224,7 +232,7 @@ pub fn msh22_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         .iter()
         .enumerate()
         .flat_map(|(j, (i, side, edges))| {
-            let tags = groups.physical_tags(*i, *side);
+            let tags = Groups::physical_tags(*i, *side);
             edges
                 .iter()
                 .flat_map(move |&e| tags.clone().into_iter().map(move |tag| (tag, j + 1, e)))

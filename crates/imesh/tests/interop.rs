@@ -111,6 +111,23 @@ fn meshio_reads_every_format_we_write() {
                 assert!(names.len() as u64 > labels, "{what}: {names:?}");
                 assert!(names.iter().any(|n| n.starts_with("border_")), "{what}");
                 assert!(read["cells"]["line"].as_u64().unwrap() > 0, "{what}");
+                // Where meshio keeps one group per line, a border line keeps its side: the
+                // lines' groups are the sides and the boundaries between labels.
+                let line_groups: Vec<&str> = read["line_groups"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|n| n.as_str().unwrap())
+                    .collect();
+                for side in SIDES {
+                    assert!(line_groups.contains(&side), "{what}: {line_groups:?}");
+                }
+                if name == "m.msh" {
+                    assert!(
+                        line_groups.iter().all(|n| !n.starts_with("border_")),
+                        "{what}: {line_groups:?}"
+                    );
+                }
             } else if name.ends_with(".inp") {
                 // An element set per label, and per side of the domain those of the faces of
                 // its surface; a node set per side.

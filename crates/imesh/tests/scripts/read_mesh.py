@@ -15,6 +15,14 @@ physical = sorted({
     if block.type in ("triangle", "quad")
     for v in tags
 })
+# The groups meshio gives the line cells (one per line: the first of its entity's groups).
+group_name = {(int(v[1]), int(v[0])): k for k, v in mesh.field_data.items()}
+line_groups = sorted({
+    group_name.get((1, int(v)), str(int(v)))
+    for block, tags in zip(mesh.cells, mesh.cell_data.get("gmsh:physical", []))
+    if block.type == "line"
+    for v in tags
+})
 # Signed areas in the file's frame: every element must be counter-clockwise.
 negative = 0
 area = 0.0
@@ -32,6 +40,7 @@ print(json.dumps({
     "labels": labels,
     "physical": physical,
     "names": sorted(mesh.field_data.keys()),
+    "line_groups": line_groups,
     "cell_sets": sorted(mesh.cell_sets.keys()),
     "point_sets": sorted(mesh.point_sets.keys()),
     "negative": int(negative),
