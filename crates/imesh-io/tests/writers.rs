@@ -64,28 +64,40 @@ fn parse_msh(text: &str) -> (Vec<[f64; 2]>, Vec<Vec<usize>>, Vec<String>) {
             [v[0], v[1]]
         })
         .collect();
-    let i = at("$Elements");
-    let mut elements = Vec::new();
-    let mut k = i + 2;
-    while lines[k] != "$EndElements" {
-        let head: Vec<usize> = lines[k].split(' ').map(|x| x.parse().unwrap()).collect();
-        let count = head[3];
-        // Surface blocks only (dimension 2); boundary lines are checked separately.
-        if head[0] == 2 {
-            for l in &lines[k + 1..k + 1 + count] {
-                let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
-                elements.push(v);
-            }
-        }
-        k += 1 + count;
-    }
+    // Surface blocks only (dimension 2); boundary lines are checked separately.
+    let elements = msh_blocks(&lines)
+        .into_iter()
+        .filter(|(dim, _, _)| *dim == 2)
+        .flat_map(|(_, _, elements)| elements)
+        .collect();
     (nodes, elements, names)
 }
 
+/// The element blocks of MSH 4.1 lines: dimension, entity, and each element's nodes.
+fn msh_blocks(lines: &[&str]) -> Vec<(usize, usize, Vec<Vec<usize>>)> {
+    let mut k = lines.iter().position(|l| *l == "$Elements").unwrap() + 2;
+    let mut blocks = Vec::new();
+    while lines[k] != "$EndElements" {
+        let head: Vec<usize> = lines[k].split(' ').map(|x| x.parse().unwrap()).collect();
+        let count = head[3];
+        let elements = lines[k + 1..k + 1 + count]
+            .iter()
+            .map(|l| l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect())
+            .collect();
+        blocks.push((head[0], head[1], elements));
+        k += 1 + count;
+    }
+    blocks
+}
+
+/// The shoelace area, from the first corner: far from the origin of coordinates (a written
+/// frame's origin at 10³ units, pixels of 0.1), products of the coordinates themselves would
+/// lose the area's digits.
 fn signed_area(p: &[[f64; 2]]) -> f64 {
-    (0..p.len())
+    let d = |q: [f64; 2]| [q[0] - p[0][0], q[1] - p[0][1]];
+    (1..p.len().saturating_sub(1))
         .map(|i| {
-            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            let (a, b) = (d(p[i]), d(p[i + 1]));
             a[0] * b[1] - a[1] * b[0]
         })
         .sum::<f64>()
@@ -268,21 +280,14 @@ fn msh_curves(text: &str) -> std::collections::BTreeMap<String, Vec<[usize; 2]>>
         physical_of.insert(v[0], v[8..8 + v[7]].to_vec());
     }
     let mut out: std::collections::BTreeMap<String, Vec<[usize; 2]>> = Default::default();
-    let mut k = at("$Elements") + 2;
-    while lines[k] != "$EndElements" {
-        let head: Vec<usize> = lines[k].split(' ').map(|x| x.parse().unwrap()).collect();
-        let count = head[3];
-        if head[0] == 1 {
-            for l in &lines[k + 1..k + 1 + count] {
-                let v: Vec<usize> = l.split(' ').skip(1).map(|x| x.parse().unwrap()).collect();
-                for tag in &physical_of[&head[1]] {
-                    out.entry(names[&(1, *tag)].clone())
-                        .or_default()
-                        .push([v[0], v[1]]);
-                }
+    for (_, entity, lines) in msh_blocks(&lines).into_iter().filter(|b| b.0 == 1) {
+        for v in lines {
+            for tag in &physical_of[&entity] {
+                out.entry(names[&(1, *tag)].clone())
+                    .or_default()
+                    .push([v[0], v[1]]);
             }
         }
-        k += 1 + count;
     }
     out
 }

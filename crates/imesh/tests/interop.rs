@@ -9,6 +9,16 @@ use std::process::Command;
 /// The sides of the domain, as the writers name them.
 const SIDES: [&str; 4] = ["left", "right", "bottom", "top"];
 
+/// The strings of a JSON array.
+fn strings(array: &serde_json::Value) -> Vec<&str> {
+    array
+        .as_array()
+        .expect("an array")
+        .iter()
+        .map(|n| n.as_str().expect("a string"))
+        .collect()
+}
+
 fn meshio_read(python: &str, file: &Path) -> serde_json::Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/read_mesh.py");
     let out = Command::new(python)
@@ -102,23 +112,13 @@ fn meshio_reads_every_format_we_write() {
             if name.ends_with(".msh") {
                 assert_eq!(count("physical"), labels, "{what}");
                 // Named surfaces, and named curves for the boundaries, the border among them.
-                let names: Vec<&str> = read["names"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|n| n.as_str().unwrap())
-                    .collect();
+                let names = strings(&read["names"]);
                 assert!(names.len() as u64 > labels, "{what}: {names:?}");
                 assert!(names.iter().any(|n| n.starts_with("border_")), "{what}");
                 assert!(read["cells"]["line"].as_u64().unwrap() > 0, "{what}");
                 // Where meshio keeps one group per line, a border line keeps its side: the
                 // lines' groups are the sides and the boundaries between labels.
-                let line_groups: Vec<&str> = read["line_groups"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|n| n.as_str().unwrap())
-                    .collect();
+                let line_groups = strings(&read["line_groups"]);
                 for side in SIDES {
                     assert!(line_groups.contains(&side), "{what}: {line_groups:?}");
                 }
@@ -131,12 +131,7 @@ fn meshio_reads_every_format_we_write() {
             } else if name.ends_with(".inp") {
                 // An element set per label, and per side of the domain those of the faces of
                 // its surface; a node set per side.
-                let sets: Vec<&str> = read["cell_sets"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|n| n.as_str().unwrap())
-                    .collect();
+                let sets = strings(&read["cell_sets"]);
                 let is_face_set = |n: &str| {
                     SIDES
                         .iter()
@@ -150,11 +145,7 @@ fn meshio_reads_every_format_we_write() {
                         "{what}: {side}"
                     );
                     assert!(
-                        read["point_sets"]
-                            .as_array()
-                            .unwrap()
-                            .iter()
-                            .any(|n| n == side),
+                        strings(&read["point_sets"]).contains(&side),
                         "{what}: {side}"
                     );
                 }
