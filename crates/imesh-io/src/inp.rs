@@ -122,13 +122,16 @@ fn side_faces(mesh: &SegmentedMeshData, sides: &[Vec<[u32; 2]>; 4]) -> [Vec<(usi
     }
     let mut faces: [Vec<(usize, usize)>; 4] = Default::default();
     for (i, e) in mesh.elements.iter().enumerate() {
-        let c = written_corners(e);
-        for k in 0..c.len() {
-            let (a, b) = (c[k], c[(k + 1) % c.len()]);
+        let c = e.corners();
+        let n = c.len();
+        for k in 0..n {
+            let (a, b) = (c[k], c[(k + 1) % n]);
             // Only a face with both ends on the border can be on it.
             if on_border[a as usize] && on_border[b as usize] {
                 if let Some(&side) = side_of.get(&[a.min(b), a.max(b)]) {
-                    faces[side].push((i, k));
+                    // The written corners run the other way from the first ([`written_corners`]):
+                    // corner k's side to the next is the written face n − 1 − k.
+                    faces[side].push((i, n - 1 - k));
                 }
             }
         }

@@ -457,8 +457,29 @@ proptest! {
 
 #[test]
 fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
-    let mesh = grid_mesh(3, 2);
-    let text = inp_string(&mesh, &Frame::default());
+    // Triangles, and the same grid's squares as quads.
+    let triangles = grid_mesh(3, 2);
+    let mut quads = triangles.clone();
+    quads.elements = triangles
+        .elements
+        .chunks(2)
+        .map(|pair| match pair {
+            [Element::Triangle([a, b, c]), Element::Triangle([_, _, d])] => {
+                Element::Quad([*a, *b, *c, *d])
+            }
+            _ => unreachable!("grid_mesh gives triangles in pairs"),
+        })
+        .collect();
+    quads.labels = triangles.labels.iter().step_by(2).copied().collect();
+    for mesh in [triangles, quads] {
+        abaqus_sides_of(&mesh);
+    }
+}
+
+/// The checks of [`abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them`] on a
+/// 3 × 2 grid.
+fn abaqus_sides_of(mesh: &SegmentedMeshData) {
+    let text = inp_string(mesh, &Frame::default());
     let lines: Vec<&str> = text.lines().collect();
     let ids = |l: &str| -> Vec<usize> { l.split(", ").map(|x| x.parse().unwrap()).collect() };
     // Nodes and elements as written (every line between keywords).

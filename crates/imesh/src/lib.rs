@@ -2197,12 +2197,12 @@ fn agreement(
     for (element, &label) in elements.iter().zip(labels) {
         if let Some(region) = regions.get_mut(label as usize) {
             region.elements += 1;
-            let corners: Vec<[f64; 2]> = element
-                .corners()
-                .iter()
-                .map(|&v| vertices[v as usize])
-                .collect();
-            region.area_px += imesh_quality::signed_area(&corners);
+            let ids = element.corners();
+            let mut corners = [[0.0; 2]; 4];
+            for (c, &v) in corners.iter_mut().zip(ids) {
+                *c = vertices[v as usize];
+            }
+            region.area_px += imesh_quality::signed_area(&corners[..ids.len()]);
         }
     }
     if w == 0 || h == 0 {
