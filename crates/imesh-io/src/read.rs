@@ -160,7 +160,8 @@ fn parse_msh(text: &str) -> Parsed {
     t.seek("$MeshFormat")?;
     let (line, version) = t.next()?;
     if version.starts_with('2') {
-        return parse_msh2(text);
+        t.format = "Gmsh MSH 2.2";
+        return parse_msh2(t);
     }
     if !version.starts_with('4') {
         return Err((F, format!("line {line}: version {version}, not 4.1 or 2.2")));
@@ -202,14 +203,15 @@ fn parse_msh(text: &str) -> Parsed {
     Ok(mesh)
 }
 
-/// MSH 2.2 ASCII: one node list, one element list whose lines carry their own tags.
-fn parse_msh2(text: &str) -> Parsed {
-    const F: &str = "Gmsh MSH 2.2";
-    let mut t = Tokens::new(text, F);
-    t.seek("$MeshFormat")?;
-    let _version = t.next()?;
+/// MSH 2.2 ASCII, from the tokens just after its version: one node list, one element list
+/// whose lines carry their own tags.
+fn parse_msh2(mut t: Tokens<'_>) -> Parsed {
+    let format = t.format;
     if t.number::<u32>()? != 0 {
-        return Err((F, "binary files are not read: write it as ASCII".into()));
+        return Err((
+            format,
+            "binary files are not read: write it as ASCII".into(),
+        ));
     }
     t.seek("$Nodes")?;
     let n: usize = t.number()?;
@@ -228,7 +230,7 @@ fn parse_msh2(text: &str) -> Parsed {
         for _ in 0..tags {
             let _: i64 = t.number()?;
         }
-        let corners = msh_corners(kind, F)?;
+        let corners = msh_corners(kind, format)?;
         mesh.elements.extend(msh_element(&mut t, &index, corners)?);
     }
     Ok(mesh)
