@@ -42,7 +42,7 @@ impl Boundary {
     ///     vertices: vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
     ///     elements: vec![Element::Quad([0, 3, 2, 1])],
     ///     labels: vec![0], label_names: vec!["a".into()], label_colours: vec![[0; 3]],
-    ///     width: 2, height: 1,
+    ///     width: 2, height: 1, second_order: None,
     /// };
     /// let border = &boundaries(&mesh)[0];
     /// let sides = border.sides(&mesh);
@@ -104,7 +104,7 @@ impl Side {
     ///     vertices: vec![[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]],
     ///     elements: vec![Element::Quad([0, 3, 2, 1])],
     ///     labels: vec![0], label_names: vec!["a".into()], label_colours: vec![[0; 3]],
-    ///     width: 3, height: 2,
+    ///     width: 3, height: 2, second_order: None,
     /// };
     /// assert_eq!(Side::of_edge(&mesh, [0, 3]), Side::Left);
     /// assert_eq!(Side::of_edge(&mesh, [0, 1]), Side::Top); // image row 0

@@ -1,4 +1,5 @@
-//! Abaqus `.inp`: nodes, CPS3/CPS4 elements with an element set per label, a node set per
+//! Abaqus `.inp`: nodes, CPS3/CPS4 elements (CPS6/CPS8 in a second-order mesh: Abaqus has no
+//! 9-node plane quad, and the quads' centre nodes are left out) with an element set per label, a node set per
 //! boundary (between two labels, and the domain border per label), and per side of the domain
 //! (`left`, `right`, `bottom`, `top`) a node set and an element-based surface
 //! (`left_surface`, ...) for boundary conditions and loads.
@@ -7,10 +8,8 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::boundary::{boundaries, edge_vertices, sanitize, Side};
-use crate::{
-    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
-};
+use crate::boundary::{boundaries, sanitize, Side};
+use crate::{check, push_lines, write_atomic, written_nodes, Frame, SegmentedMeshData, WriteError};
 
 /// The `.inp` text of `mesh`.
 pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
@@ -22,8 +21,10 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         mesh.height,
         mesh.elements.len()
     );
-    push_lines(&mut s, mesh.vertices.len(), |i, s| {
-        let q = frame.map(mesh, mesh.vertices[i]);
+    // The quads' centre nodes come last, and no Abaqus element uses them.
+    let nodes = mesh.vertices.len() + mesh.second_order.as_ref().map_or(0, |s| s.edges.len());
+    push_lines(&mut s, nodes, |i, s| {
+        let q = frame.map(mesh, mesh.node(i));
         let _ = writeln!(s, "{}, {}, {}", i + 1, q[0], q[1]);
     });
     // Per label, its triangles and its quads, in one pass over the elements.
@@ -37,7 +38,11 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let mut number = vec![0usize; mesh.elements.len()];
     let mut tag = 0usize;
     for (name, kinds) in mesh.label_names.iter().zip(&members) {
-        for (kind, members) in ["CPS3", "CPS4"].into_iter().zip(kinds) {
+        let names = match mesh.second_order {
+            None => ["CPS3", "CPS4"],
+            Some(_) => ["CPS6", "CPS8"],
+        };
+        for (kind, members) in names.into_iter().zip(kinds) {
             if members.is_empty() {
                 continue;
             }
@@ -45,7 +50,7 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
             for &i in members {
                 tag += 1;
                 number[i] = tag;
-                let ids: Vec<String> = written_corners(&mesh.elements[i])
+                let ids: Vec<String> = written_nodes(mesh, i, false)
                     .iter()
                     .map(|v| (v + 1).to_string())
                     .collect();
@@ -60,7 +65,7 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         write_ids(s, &ids);
     };
     for b in &curves {
-        node_set(&mut s, &b.name(mesh), &b.vertices());
+        node_set(&mut s, &b.name(mesh), &mesh.edge_nodes(&b.edges));
     }
     // The sides of the domain, for boundary conditions: a node set each, and an element-based
     // surface (the element faces along it, by face number) for loads.
@@ -75,7 +80,7 @@ pub fn inp_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         if edges.is_empty() {
             continue;
         }
-        node_set(&mut s, side.name(), &edge_vertices(edges));
+        node_set(&mut s, side.name(), &mesh.edge_nodes(edges));
         // Per face number, the elements with that face on the side.
         let mut by_face: [Vec<usize>; 4] = Default::default();
         for (element, face) in faces {

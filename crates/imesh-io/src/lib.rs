@@ -19,6 +19,7 @@
 //!     label_colours: vec![[200, 200, 200]],
 //!     width: 2,
 //!     height: 1,
+//!     second_order: None,
 //! };
 //! let dir = tempfile::tempdir().unwrap();
 //! let path = dir.path().join("plate.msh");
@@ -34,6 +35,7 @@ mod inp;
 mod msh;
 mod png;
 mod read;
+mod second_order;
 mod svg;
 mod vtk;
 mod vtu;
@@ -49,6 +51,7 @@ pub use inp::{inp_string, write_inp};
 pub use msh::{msh22_string, msh_string, write_msh, write_msh22};
 pub use png::{rasterise, write_png};
 pub use read::{read_mesh, ReadError, ReadMesh};
+pub use second_order::{SecondOrder, CURVED_JACOBIAN_SHARE, NO_NODE};
 pub use svg::{svg_string, write_svg, SvgOptions};
 pub use vtk::{vtk_string, write_vtk};
 pub use vtu::{vtu_string, write_vtu};
@@ -70,6 +73,9 @@ pub struct SegmentedMeshData {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
+    /// The extra nodes of second-order elements ([`SecondOrder::new`]); `None` for a linear
+    /// mesh.
+    pub second_order: Option<SecondOrder>,
 }
 
 impl SegmentedMeshData {
@@ -80,7 +86,7 @@ impl SegmentedMeshData {
     /// use imesh_io::SegmentedMeshData;
     /// let mesh = SegmentedMeshData {
     ///     vertices: vec![], elements: vec![], labels: vec![3, 0, 3, 2],
-    ///     label_names: vec![], label_colours: vec![], width: 1, height: 1,
+    ///     label_names: vec![], label_colours: vec![], width: 1, height: 1, second_order: None,
     /// };
     /// assert_eq!(mesh.used_labels(), vec![0, 2, 3]);
     /// ```
@@ -89,6 +95,50 @@ impl SegmentedMeshData {
         used.sort_unstable();
         used.dedup();
         used
+    }
+
+    /// The nodes a writer lists: the vertices, then the second-order nodes.
+    pub fn node_count(&self) -> usize {
+        self.vertices.len() + self.second_order.as_ref().map_or(0, |s| s.points.len())
+    }
+
+    /// Node `i` ([`SegmentedMeshData::node_count`]), image coordinates.
+    pub fn node(&self, i: usize) -> [f64; 2] {
+        match (i.checked_sub(self.vertices.len()), &self.second_order) {
+            (Some(k), Some(s)) => s.points[k],
+            _ => self.vertices[i],
+        }
+    }
+
+    /// The area element `i` covers: its corners' polygon, or with second-order nodes a quad's
+    /// curved area ([`imesh_quality::curved::area`]; a triangle's sides stay straight).
+    pub fn element_area(&self, i: usize) -> f64 {
+        let e = &self.elements[i];
+        let corner = |v: &u32| self.vertices[*v as usize];
+        match (e, &self.second_order) {
+            (Element::Quad(c), Some(s)) => {
+                let node = |k: u32| self.node(k as usize);
+                let mut q = [[0.0; 2]; 9];
+                for k in 0..4 {
+                    q[k] = corner(&c[k]);
+                    q[4 + k] = node(s.sides[i][k]);
+                }
+                q[8] = node(s.centres[i]);
+                imesh_quality::curved::area(&q)
+            }
+            _ => imesh_quality::signed_area(&e.corners().iter().map(corner).collect::<Vec<_>>()),
+        }
+    }
+
+    /// The nodes of the boundary `edges`, sorted, each once: their ends, and their middle
+    /// nodes in a second-order mesh.
+    pub fn edge_nodes(&self, edges: &[[u32; 2]]) -> Vec<u32> {
+        let mut nodes = boundary::edge_vertices(edges);
+        if let Some(s) = &self.second_order {
+            nodes.extend(edges.iter().filter_map(|&e| s.middle(e)));
+            nodes.sort_unstable();
+        }
+        nodes
     }
 }
 
@@ -118,7 +168,7 @@ impl Frame {
     /// use imesh_io::{Frame, SegmentedMeshData};
     /// let mesh = SegmentedMeshData {
     ///     vertices: vec![], elements: vec![], labels: vec![],
-    ///     label_names: vec![], label_colours: vec![], width: 4, height: 3,
+    ///     label_names: vec![], label_colours: vec![], width: 4, height: 3, second_order: None,
     /// };
     /// // Pixels of 0.5 mm, the image's bottom-left corner at (10, 20) mm.
     /// let frame = Frame { pixel_size: [0.5, 0.5], origin: [10.0, 20.0] };
@@ -140,6 +190,24 @@ pub fn written_corners(e: &Element) -> Vec<u32> {
     std::iter::once(c[0])
         .chain(c[1..].iter().rev().copied())
         .collect()
+}
+
+/// Element `i`'s nodes in the written frame's order: its [`written_corners`], then in a
+/// second-order mesh the middle node of each written side (from written corner k to the next),
+/// then, with `centre`, a quad's centre node (Gmsh's and VTK's 9-node quad; Abaqus's 8-node
+/// quad has none).
+pub fn written_nodes(mesh: &SegmentedMeshData, i: usize, centre: bool) -> Vec<u32> {
+    let e = &mesh.elements[i];
+    let mut nodes = written_corners(e);
+    if let Some(s) = &mesh.second_order {
+        let n = e.corners().len();
+        // Written side k is the element's side n − 1 − k, run the other way.
+        nodes.extend((0..n).map(|k| s.sides[i][n - 1 - k]));
+        if centre && s.centres[i] != NO_NODE {
+            nodes.push(s.centres[i]);
+        }
+    }
+    nodes
 }
 
 /// A write that failed.
@@ -236,6 +304,26 @@ pub(crate) fn check(path: &Path, mesh: &SegmentedMeshData) -> Result<(), WriteEr
         .any(|e| e.corners().iter().any(|&v| v >= n))
     {
         return Err(invalid("an element refers to a missing vertex".into()));
+    }
+    if let Some(so) = &mesh.second_order {
+        let nodes = mesh.node_count() as u32;
+        let in_range = |v: &u32| *v < nodes;
+        if so.sides.len() != mesh.elements.len()
+            || so.centres.len() != mesh.elements.len()
+            || mesh
+                .elements
+                .iter()
+                .zip(&so.sides)
+                .zip(&so.centres)
+                .any(|((e, s), c)| {
+                    let k = e.corners().len();
+                    !s[..k].iter().all(in_range) || (k == 4) != in_range(c)
+                })
+        {
+            return Err(invalid(
+                "the second-order nodes do not match the elements".into(),
+            ));
+        }
     }
     if let Some(&l) = mesh
         .labels

@@ -7,9 +7,7 @@ use std::path::Path;
 use imesh_quality::Element;
 
 use crate::boundary::{boundaries, edge_vertices, Boundary, Side, OUTSIDE};
-use crate::{
-    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
-};
+use crate::{check, push_lines, write_atomic, written_nodes, Frame, SegmentedMeshData, WriteError};
 
 /// The MSH 4.1 text of `mesh`: nodes (all in one block), then one element block per label,
 /// each on its own surface entity carrying the physical surface `label + 1` named after the
@@ -26,7 +24,9 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let groups = Groups::of(mesh);
     groups.write_names(mesh, &mut s);
     let Groups { used, entities, .. } = &groups;
-    let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(mesh, p)).collect();
+    let mapped: Vec<[f64; 2]> = (0..mesh.node_count())
+        .map(|i| frame.map(mesh, mesh.node(i)))
+        .collect();
     let (lo, hi) = bounds(&mapped);
     let _ = writeln!(s, "$Entities\n0 {} {} 0", entities.len(), used.len());
     for (j, (i, side, edges)) in entities.iter().enumerate() {
@@ -75,11 +75,12 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let labels = used.iter().max().map_or(0, |&l| l as usize + 1);
     let mut members: Vec<[Vec<usize>; 2]> = vec![Default::default(); labels];
     for (i, (e, &l)) in mesh.elements.iter().zip(&mesh.labels).enumerate() {
-        members[l as usize][usize::from(gmsh_type(e) == 3)].push(i);
+        members[l as usize][usize::from(matches!(e, Element::Quad(_)))].push(i);
     }
     let mut blocks: Vec<(u32, u32, Vec<usize>)> = Vec::new();
     for &l in used {
-        for (kind, members) in [2u32, 3]
+        let kinds = [Element::Triangle([0; 3]), Element::Quad([0; 4])].map(|e| gmsh_type(mesh, &e));
+        for (kind, members) in kinds
             .into_iter()
             .zip(std::mem::take(&mut members[l as usize]))
         {
@@ -96,18 +97,19 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         let _ = writeln!(s, "2 {} {kind} {}", l + 1, members.len());
         push_lines(&mut s, members.len(), |k, s| {
             let _ = write!(s, "{}", tag + k);
-            for v in written_corners(&mesh.elements[members[k]]) {
+            for v in written_nodes(mesh, members[k], true) {
                 let _ = write!(s, " {}", v + 1);
             }
             s.push('\n');
         });
         tag += members.len();
     }
-    // Boundary edges as 2-node lines (type 1) on their curve entities.
+    // Boundary edges as lines on their curve entities: 2-node (type 1), or 3-node (type 8,
+    // the middle last) in a second-order mesh.
     for (j, (_, _, edges)) in entities.iter().enumerate() {
-        let _ = writeln!(s, "1 {} 1 {}", j + 1, edges.len());
-        for e in edges {
-            let _ = writeln!(s, "{tag} {} {}", e[0] + 1, e[1] + 1);
+        let _ = writeln!(s, "1 {} {} {}", j + 1, line_type(mesh), edges.len());
+        for &e in edges {
+            let _ = writeln!(s, "{tag} {}", line_nodes(mesh, e));
             tag += 1;
         }
     }
@@ -208,7 +210,7 @@ impl Groups {
 ///     vertices: vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
 ///     elements: vec![Element::Quad([0, 1, 2, 3])],
 ///     labels: vec![0], label_names: vec!["steel".into()], label_colours: vec![[0; 3]],
-///     width: 2, height: 1,
+///     width: 2, height: 1, second_order: None,
 /// };
 /// let text = msh22_string(&mesh, &Frame::default());
 /// assert!(text.starts_with("$MeshFormat\n2.2 0 8\n"));
@@ -220,10 +222,10 @@ pub fn msh22_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let _ = writeln!(s, "$MeshFormat\n2.2 0 8\n$EndMeshFormat");
     let groups = Groups::of(mesh);
     groups.write_names(mesh, &mut s);
-    let n = mesh.vertices.len();
+    let n = mesh.node_count();
     let _ = writeln!(s, "$Nodes\n{n}");
     push_lines(&mut s, n, |i, s| {
-        let q = frame.map(mesh, mesh.vertices[i]);
+        let q = frame.map(mesh, mesh.node(i));
         let _ = writeln!(s, "{} {} {} 0", i + 1, q[0], q[1]);
     });
     let _ = writeln!(s, "$EndNodes");
@@ -241,15 +243,17 @@ pub fn msh22_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let _ = writeln!(s, "$Elements\n{}", mesh.elements.len() + lines.len());
     push_lines(&mut s, mesh.elements.len(), |i, s| {
         let (e, l) = (&mesh.elements[i], mesh.labels[i] + 1);
-        let _ = write!(s, "{} {} 2 {l} {l}", i + 1, gmsh_type(e));
-        for v in written_corners(e) {
+        let _ = write!(s, "{} {} 2 {l} {l}", i + 1, gmsh_type(mesh, e));
+        for v in written_nodes(mesh, i, true) {
             let _ = write!(s, " {}", v + 1);
         }
         s.push('\n');
     });
     let first = mesh.elements.len() + 1;
-    for (k, (tag, entity, [a, b])) in lines.iter().enumerate() {
-        let _ = writeln!(s, "{} 1 2 {tag} {entity} {} {}", first + k, a + 1, b + 1);
+    let kind = line_type(mesh);
+    for (k, &(tag, entity, e)) in lines.iter().enumerate() {
+        let nodes = line_nodes(mesh, e);
+        let _ = writeln!(s, "{} {kind} 2 {tag} {entity} {nodes}", first + k);
     }
     let _ = writeln!(s, "$EndElements");
     s
@@ -273,10 +277,33 @@ pub fn write_msh(path: &Path, mesh: &SegmentedMeshData, frame: &Frame) -> Result
     write_atomic(path, msh_string(mesh, frame).as_bytes())
 }
 
-fn gmsh_type(e: &Element) -> u32 {
-    match e {
-        Element::Triangle(_) => 2,
-        Element::Quad(_) => 3,
+/// Gmsh's element type: 3-node triangle 2, 4-node quad 3; second order, 6-node triangle 9,
+/// 9-node quad 10.
+fn gmsh_type(mesh: &SegmentedMeshData, e: &Element) -> u32 {
+    match (e, mesh.second_order.is_some()) {
+        (Element::Triangle(_), false) => 2,
+        (Element::Quad(_), false) => 3,
+        (Element::Triangle(_), true) => 9,
+        (Element::Quad(_), true) => 10,
+    }
+}
+
+/// Gmsh's type of the boundary lines: 2-node 1, 3-node 8.
+fn line_type(mesh: &SegmentedMeshData) -> u32 {
+    if mesh.second_order.is_some() {
+        8
+    } else {
+        1
+    }
+}
+
+/// A boundary line's node numbers as Gmsh lists them: its ends, then its middle node in a
+/// second-order mesh.
+fn line_nodes(mesh: &SegmentedMeshData, [a, b]: [u32; 2]) -> String {
+    let middle = mesh.second_order.as_ref().and_then(|s| s.middle([a, b]));
+    match middle {
+        Some(m) => format!("{} {} {}", a + 1, b + 1, m + 1),
+        None => format!("{} {}", a + 1, b + 1),
     }
 }
 

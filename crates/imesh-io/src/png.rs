@@ -22,6 +22,7 @@ use crate::{check, write_atomic, SegmentedMeshData, WriteError};
 ///     label_colours: vec![[10, 200, 30]],
 ///     width: 4,
 ///     height: 2,
+///     second_order: None,
 /// };
 /// let picture = rasterise(&mesh, 2.0, false);
 /// assert_eq!(picture.dimensions(), (8, 4));

@@ -119,33 +119,43 @@ impl<'a> Tokens<'a> {
     }
 }
 
-/// The corners an MSH element type has, for the types read (lines and points are skipped).
-fn msh_corners(kind: u32, format: &'static str) -> Result<usize, (&'static str, String)> {
+/// The nodes an MSH element type has and its corners, for the types read: lines (2- and
+/// 3-node) and points are skipped, a second-order triangle (6 nodes) or quad (8 or 9) is read
+/// as its corners.
+fn msh_corners(kind: u32, format: &'static str) -> Result<(usize, usize), (&'static str, String)> {
     match kind {
-        1 => Ok(2),
-        2 => Ok(3),
-        3 => Ok(4),
-        15 => Ok(1),
+        1 => Ok((2, 0)),
+        8 => Ok((3, 0)),
+        2 => Ok((3, 3)),
+        9 => Ok((6, 3)),
+        3 => Ok((4, 4)),
+        16 => Ok((8, 4)),
+        10 => Ok((9, 4)),
+        15 => Ok((1, 0)),
         other => Err((format, format!("element type {other} is not read"))),
     }
 }
 
-/// Reads `corners` node tags into an element (none for a line or a point).
+/// Reads `nodes` node tags into an element of the first `corners` (none for a line or a
+/// point).
 fn msh_element(
     t: &mut Tokens<'_>,
     index: &HashMap<usize, u32>,
-    corners: usize,
+    (nodes, corners): (usize, usize),
 ) -> Result<Option<Element>, (&'static str, String)> {
     let format = t.format;
     let mut c = [0u32; 4];
-    for slot in c.iter_mut().take(corners) {
+    for k in 0..nodes {
         let (line, tag) = t.next()?;
         let tag: usize = tag
             .parse()
             .map_err(|_| (format, format!("line {line}: {tag:?} is not a node tag")))?;
-        *slot = *index
+        let node = *index
             .get(&tag)
             .ok_or((format, format!("line {line}: no node {tag}")))?;
+        if let Some(slot) = c.get_mut(k).filter(|_| k < corners) {
+            *slot = node;
+        }
     }
     Ok(match corners {
         3 => Some(Element::Triangle([c[0], c[1], c[2]])),
@@ -279,8 +289,12 @@ fn parse_vtk(text: &str) -> Parsed {
     let _: usize = t.number()?;
     for ids in lists {
         match (t.number::<u32>()?, ids.as_slice()) {
-            (5, &[a, b, c]) => mesh.elements.push(Element::Triangle([a, b, c])),
-            (9, &[a, b, c, d]) => mesh.elements.push(Element::Quad([a, b, c, d])),
+            (5, &[a, b, c]) | (22, &[a, b, c, _, _, _]) => {
+                mesh.elements.push(Element::Triangle([a, b, c]))
+            }
+            (9, &[a, b, c, d]) | (23 | 28, &[a, b, c, d, ..]) => {
+                mesh.elements.push(Element::Quad([a, b, c, d]))
+            }
             _ => {}
         }
     }

@@ -5,9 +5,7 @@ use std::path::Path;
 
 use imesh_quality::Element;
 
-use crate::{
-    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
-};
+use crate::{check, push_lines, write_atomic, written_nodes, Frame, SegmentedMeshData, WriteError};
 
 /// The legacy `.vtk` text of `mesh`, with cell data `label` and each `(name, values)`.
 pub fn vtk_string(
@@ -16,16 +14,20 @@ pub fn vtk_string(
     cell_data: &[(String, Vec<f64>)],
 ) -> String {
     let mut s = String::new();
-    let (n, m) = (mesh.vertices.len(), mesh.elements.len());
+    let (n, m) = (mesh.node_count(), mesh.elements.len());
     let _ = writeln!(s, "# vtk DataFile Version 3.0\nimesh {}x{} px image\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS {n} double", mesh.width, mesh.height);
     push_lines(&mut s, n, |i, s| {
-        let q = frame.map(mesh, mesh.vertices[i]);
+        let q = frame.map(mesh, mesh.node(i));
         let _ = writeln!(s, "{} {} 0", q[0], q[1]);
     });
-    let size: usize = mesh.elements.iter().map(|e| e.corners().len() + 1).sum();
+    let size: usize = mesh
+        .elements
+        .iter()
+        .map(|e| vtk_node_count(mesh, e) + 1)
+        .sum();
     let _ = writeln!(s, "CELLS {m} {size}");
     push_lines(&mut s, m, |i, s| {
-        let c = written_corners(&mesh.elements[i]);
+        let c = written_nodes(mesh, i, true);
         let _ = write!(s, "{}", c.len());
         for v in c {
             let _ = write!(s, " {v}");
@@ -34,14 +36,7 @@ pub fn vtk_string(
     });
     let _ = writeln!(s, "CELL_TYPES {m}");
     for e in &mesh.elements {
-        let _ = writeln!(
-            s,
-            "{}",
-            match e {
-                Element::Triangle(_) => 5,
-                Element::Quad(_) => 9,
-            }
-        );
+        let _ = writeln!(s, "{}", vtk_type(mesh, e));
     }
     let _ = writeln!(
         s,
@@ -76,4 +71,25 @@ pub fn write_vtk(
     check(path, mesh)?;
     crate::vtu::check_cell_data(path, mesh, cell_data)?;
     write_atomic(path, vtk_string(mesh, frame, cell_data).as_bytes())
+}
+
+/// VTK's cell type: triangle 5, quad 9; second order, quadratic triangle 22, biquadratic
+/// (9-node) quad 28.
+pub(crate) fn vtk_type(mesh: &SegmentedMeshData, e: &Element) -> u8 {
+    match (e, mesh.second_order.is_some()) {
+        (Element::Triangle(_), false) => 5,
+        (Element::Quad(_), false) => 9,
+        (Element::Triangle(_), true) => 22,
+        (Element::Quad(_), true) => 28,
+    }
+}
+
+/// The nodes of a VTK cell of element `e`: its corners, and in a second-order mesh its sides'
+/// middles and a quad's centre.
+pub(crate) fn vtk_node_count(mesh: &SegmentedMeshData, e: &Element) -> usize {
+    let n = e.corners().len();
+    match mesh.second_order {
+        None => n,
+        Some(_) => 2 * n + usize::from(n == 4),
+    }
 }

@@ -3,11 +3,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use imesh_quality::Element;
-
-use crate::{
-    check, push_lines, write_atomic, written_corners, Frame, SegmentedMeshData, WriteError,
-};
+use crate::vtk::{vtk_node_count, vtk_type};
+use crate::{check, push_lines, write_atomic, written_nodes, Frame, SegmentedMeshData, WriteError};
 
 /// The `.vtu` text of `mesh`, with cell data `label` and each `(name, values)` of `cell_data`.
 pub fn vtu_string(
@@ -16,7 +13,7 @@ pub fn vtu_string(
     cell_data: &[(String, Vec<f64>)],
 ) -> String {
     let mut s = String::new();
-    let (n, m) = (mesh.vertices.len(), mesh.elements.len());
+    let (n, m) = (mesh.node_count(), mesh.elements.len());
     let _ = writeln!(
         s,
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{m}\">"
@@ -26,7 +23,7 @@ pub fn vtu_string(
         "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
     );
     push_lines(&mut s, n, |i, s| {
-        let q = frame.map(mesh, mesh.vertices[i]);
+        let q = frame.map(mesh, mesh.node(i));
         let _ = writeln!(s, "{} {} 0", q[0], q[1]);
     });
     let _ = writeln!(s, "</DataArray>\n</Points>\n<Cells>");
@@ -35,7 +32,7 @@ pub fn vtu_string(
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     );
     push_lines(&mut s, m, |i, s| {
-        for (k, v) in written_corners(&mesh.elements[i]).into_iter().enumerate() {
+        for (k, v) in written_nodes(mesh, i, true).into_iter().enumerate() {
             let _ = write!(s, "{}{v}", if k == 0 { "" } else { " " });
         }
         s.push('\n');
@@ -46,7 +43,7 @@ pub fn vtu_string(
     );
     let mut offset = 0;
     for e in &mesh.elements {
-        offset += e.corners().len();
+        offset += vtk_node_count(mesh, e);
         let _ = writeln!(s, "{offset}");
     }
     let _ = writeln!(
@@ -54,11 +51,7 @@ pub fn vtu_string(
         "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
     );
     for e in &mesh.elements {
-        let kind = match e {
-            Element::Triangle(_) => 5,
-            Element::Quad(_) => 9,
-        };
-        let _ = writeln!(s, "{kind}");
+        let _ = writeln!(s, "{}", vtk_type(mesh, e));
     }
     let _ = writeln!(s, "</DataArray>\n</Cells>\n<CellData Scalars=\"label\">");
     let _ = writeln!(

@@ -1,8 +1,8 @@
 //! The writers: y-up counter-clockwise output, exact areas, atomic failure.
 
 use imesh_io::{
-    boundaries, inp_string, msh22_string, msh_string, vtk_string, vtu_string, write_msh,
-    written_corners, Frame, SegmentedMeshData, OUTSIDE,
+    boundaries, inp_string, msh22_string, msh_string, read_mesh, vtk_string, vtu_string, write_msh,
+    write_msh22, written_corners, Frame, SecondOrder, SegmentedMeshData, OUTSIDE,
 };
 use imesh_quality::Element;
 use proptest::prelude::*;
@@ -39,6 +39,7 @@ fn grid_mesh(w: u32, h: u32) -> SegmentedMeshData {
         label_colours: vec![[0, 0, 0], [255, 255, 255]],
         width: w,
         height: h,
+        second_order: None,
     }
 }
 
@@ -473,6 +474,12 @@ fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
     quads.labels = triangles.labels.iter().step_by(2).copied().collect();
     for mesh in [triangles, quads] {
         abaqus_sides_of(&mesh);
+        // Second order: the sides' middle nodes join the sides' node sets.
+        let second = SegmentedMeshData {
+            second_order: Some(SecondOrder::new(&mesh, &[])),
+            ..mesh
+        };
+        abaqus_sides_of(&second);
     }
 }
 
@@ -528,10 +535,9 @@ fn abaqus_sides_of(mesh: &SegmentedMeshData) {
             assert_eq!(set, format!("{name}_S{face}"));
             for e in &sets[set] {
                 let corners = &elements[e];
-                let (p, q) = (
-                    nodes[&corners[face - 1]],
-                    nodes[&corners[face % corners.len()]],
-                );
+                // 3 or 4 corners first (then a second-order element's side middles).
+                let n = if corners.len() % 3 == 0 { 3 } else { 4 };
+                let (p, q) = (nodes[&corners[face - 1]], nodes[&corners[face % n]]);
                 assert!(
                     p[axis] == value && q[axis] == value,
                     "{name}: element {e} face {face}"
@@ -562,4 +568,165 @@ fn legacy_vtk_counts_and_labels() {
     assert!(text.contains("CELLS 12 48"));
     assert!(text.contains("SCALARS label int 1"));
     assert!(text.contains("SCALARS shape double 1"));
+}
+
+/// The 3 × 2 grid of [`grid_mesh`] with its squares as quads, in second order, the side
+/// between the first two columns' top quads bent 0.2 to the right: the point it was given.
+fn second_order_quads() -> (SegmentedMeshData, [f64; 2]) {
+    let triangles = grid_mesh(3, 2);
+    let mut mesh = triangles.clone();
+    mesh.elements = triangles
+        .elements
+        .chunks(2)
+        .map(|pair| match pair {
+            [Element::Triangle([a, b, c]), Element::Triangle([_, _, d])] => {
+                Element::Quad([*a, *b, *c, *d])
+            }
+            _ => unreachable!("grid_mesh gives triangles in pairs"),
+        })
+        .collect();
+    mesh.labels = triangles.labels.iter().step_by(2).copied().collect();
+    // Vertices 1 = (1, 0) and 5 = (1, 1).
+    let bent = [1.2, 0.5];
+    let so = SecondOrder::new(&mesh, &[([1, 5], bent)]);
+    assert_eq!(so.curved, 1);
+    mesh.second_order = Some(so);
+    (mesh, bent)
+}
+
+#[test]
+fn second_order_msh_lists_each_element_s_side_middles_in_its_written_order() {
+    let frame = Frame {
+        pixel_size: [2.0, 0.5],
+        origin: [10.0, -3.0],
+    };
+    let triangles = {
+        let mut t = grid_mesh(3, 2);
+        t.second_order = Some(SecondOrder::new(&t, &[]));
+        t
+    };
+    let (quads, bent) = second_order_quads();
+    for mesh in [triangles, quads] {
+        let text = msh_string(&mesh, &frame);
+        let (nodes, elements, _) = parse_msh(&text);
+        assert_eq!(nodes.len(), mesh.node_count());
+        let bent = frame.map(&mesh, bent);
+        let half = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-12;
+        let mut total = 0.0;
+        let mut bent_seen = 0;
+        for e in &elements {
+            let p: Vec<[f64; 2]> = e.iter().map(|&v| nodes[v - 1]).collect();
+            let n = if p.len() == 6 { 3 } else { 4 };
+            assert!(p.len() == 6 || p.len() == 9, "{} nodes", p.len());
+            for k in 0..n {
+                let (m, straight) = (p[n + k], half(p[k], p[(k + 1) % n]));
+                if close(m, bent) {
+                    bent_seen += 1;
+                } else {
+                    assert!(close(m, straight), "side {k} of {e:?}: {m:?}");
+                }
+            }
+            total += if n == 3 {
+                signed_area(&p[..3])
+            } else {
+                let q: [[f64; 2]; 9] = p.clone().try_into().unwrap();
+                let a = imesh_quality::curved::area(&q);
+                assert!(imesh_quality::curved::jacobian_bounds(&q)[0] > 0.0);
+                a
+            };
+        }
+        // The bent side's two quads both list it; the areas still sum to the domain's.
+        assert_eq!(bent_seen, if n_quads(&mesh) > 0 { 2 } else { 0 });
+        assert!((total - 6.0 * 2.0 * 0.5).abs() < 1e-9, "{total}");
+        // Every boundary line has 3 nodes, its middle the side's middle node.
+        let lines: Vec<&str> = text.lines().collect();
+        for (dim, _, lines) in msh_blocks(&lines) {
+            if dim == 1 {
+                for l in lines {
+                    assert_eq!(l.len(), 3);
+                    let m = nodes[l[2] - 1];
+                    assert!(close(m, half(nodes[l[0] - 1], nodes[l[1] - 1])) || close(m, bent));
+                }
+            }
+        }
+    }
+}
+
+fn n_quads(mesh: &SegmentedMeshData) -> usize {
+    mesh.elements
+        .iter()
+        .filter(|e| matches!(e, Element::Quad(_)))
+        .count()
+}
+
+#[test]
+fn second_order_files_of_every_format_read_back_as_their_corners() {
+    let (mesh, _) = second_order_quads();
+    let frame = Frame::default();
+    let dir = tempfile::tempdir().unwrap();
+    let msh22 = dir.path().join("q.msh");
+    write_msh22(&msh22, &mesh, &frame).unwrap();
+    let text = std::fs::read_to_string(&msh22).unwrap();
+    // Quads of type 10 with 9 nodes, lines of type 8 with 3.
+    assert!(text
+        .lines()
+        .any(|l| l.starts_with("1 10 2 1 1 ") && l.split(' ').count() == 5 + 9));
+    assert!(text
+        .lines()
+        .any(|l| l.split(' ').nth(1) == Some("8") && l.split(' ').count() == 5 + 3));
+    for path in [msh22, dir.path().join("q41.msh"), dir.path().join("q.vtk")] {
+        if path.extension().unwrap() == "vtk" {
+            imesh_io::write_vtk(&path, &mesh, &frame, &[]).unwrap();
+        } else if path.ends_with("q41.msh") {
+            write_msh(&path, &mesh, &frame).unwrap();
+        }
+        let read = read_mesh(&path).unwrap();
+        assert_eq!(read.vertices.len(), mesh.node_count(), "{path:?}");
+        // The same corner polygons (MSH 4.1 lists the elements by label).
+        let polygons =
+            |vertices: &[[f64; 2]], elements: &[Element], map: &dyn Fn([f64; 2]) -> [f64; 2]| {
+                let mut all: Vec<String> = elements
+                    .iter()
+                    .map(|e| {
+                        format!(
+                            "{:?}",
+                            e.corners()
+                                .iter()
+                                .map(|&v| map(vertices[v as usize]))
+                                .collect::<Vec<_>>()
+                        )
+                    })
+                    .collect();
+                all.sort();
+                all
+            };
+        let written: Vec<Element> = mesh
+            .elements
+            .iter()
+            .map(|e| Element::Quad(written_corners(e).try_into().unwrap()))
+            .collect();
+        assert_eq!(
+            polygons(&read.vertices, &read.elements, &|p| p),
+            polygons(&mesh.vertices, &written, &|p| frame.map(&mesh, p)),
+            "{path:?}"
+        );
+    }
+    // VTK: 9-node biquadratic quads (28); the XML file the same.
+    let vtk = vtk_string(&mesh, &frame, &[]);
+    assert!(vtk.contains("CELLS 6 60\n9 "));
+    assert_eq!(vtk.lines().filter(|l| *l == "28").count(), 6);
+    let vtu = vtu_string(&mesh, &frame, &[]);
+    assert!(vtu.contains("Name=\"offsets\" format=\"ascii\">\n9\n18\n"));
+    // Abaqus: 8-node quads, no centre nodes written.
+    let inp = inp_string(&mesh, &frame);
+    assert!(inp.contains("*Element, type=CPS8, elset=even\n"));
+    let so = mesh.second_order.as_ref().unwrap();
+    let written_nodes = inp
+        .lines()
+        .skip_while(|l| *l != "*Node")
+        .skip(1)
+        .take_while(|l| !l.starts_with('*'))
+        .count();
+    assert_eq!(written_nodes, mesh.vertices.len() + so.edges.len());
 }

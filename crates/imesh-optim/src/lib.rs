@@ -68,7 +68,7 @@ pub use repair::{REPAIR_FLOOR, REPAIR_JACOBIAN};
 use std::time::Instant;
 
 use imesh_geom::Point;
-use imesh_quad::Remesh;
+use imesh_quad::{BoundaryChain, Remesh};
 use imesh_quality::{QuadHistograms, QuadQuality};
 use rayon::prelude::*;
 
@@ -293,6 +293,10 @@ pub struct OptimReport {
     pub repaired_sliders: usize,
     /// Patches moved for the quality of their poorest quads ([`OptimOptions::quality_repair`]).
     pub quality_repaired: usize,
+    /// The boundary chains with their vertices where sliding left them along the curves, for
+    /// second-order sides that follow the curves between them; `None` when the method does not
+    /// slide (the vertices are where [`Remesh::boundary_chains`] finds them).
+    pub boundary: Option<Vec<BoundaryChain>>,
     /// Wall-clock seconds.
     pub seconds: f64,
     /// Quality before.
@@ -715,7 +719,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     };
     let (repaired, repaired_sliders, quality_repaired) =
         if options.repair && matches!(options.method, Method::Local | Method::Vertex) {
-            let descended = mesh.vertices.clone();
+            let (descended, descended_sliders) = (mesh.vertices.clone(), sliders.clone());
             // The repair trades a quad's size for the corners of its neighbours: of the metric it
             // keeps only the start's worst (held to each quad's own, it left grass's worst shape
             // 0.136 → 0.106 and stardist's 0.312 → 0.302); a quad's shape and scaled Jacobian may
@@ -801,6 +805,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             // (on the fixtures it costs 0.001 of mean shape-and-size at most).
             if moved + raised > 0 && setup.energy(&mesh.vertices) > energy_before {
                 mesh.vertices = descended;
+                sliders = descended_sliders;
                 (0, 0, 0)
             } else {
                 (moved, slid, raised)
@@ -822,6 +827,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         energy_after,
         sweeps,
         sliders: sliders.len(),
+        boundary: sliding.then(|| sliders.into_chains()),
         repaired,
         repaired_sliders,
         quality_repaired,

@@ -7,111 +7,32 @@
 //! follows the boundary equally well. Moving a vertex along the curve keeps it exactly on the
 //! curve and changes only where, between its neighbours on the same curve, it sits.
 
-use imesh_curves::CubicBezier;
 use imesh_geom::Point;
-use imesh_quad::Remesh;
+use imesh_quad::{BoundaryChain, Remesh};
 use rayon::prelude::*;
 
 use crate::variables::{by_quad, colour, vertex_quads, Rows};
 use crate::Setup;
 
-/// One G' edge's boundary path: the pieces (M edges) in order along it, and the quad vertices
-/// on it; vertex `j` sits at `along[j]` (piece `⌊along⌋`, parameter `along − ⌊along⌋` on it).
-#[derive(Clone, Debug, Default)]
-struct Chain {
-    pieces: Vec<CubicBezier>,
-    vertices: Vec<u32>,
-}
-
-impl Chain {
-    fn point(&self, along: f64) -> Point {
-        let last = self.pieces.len() - 1;
-        let p = (along.floor() as usize).min(last);
-        self.pieces[p].eval(along - p as f64)
-    }
-}
-
 /// The sliding vertices of a mesh.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Sliders {
-    chains: Vec<Chain>,
+    chains: Vec<BoundaryChain>,
     /// Per slider: its chain and its index there (never the first or the last).
     slot: Vec<(u32, u32)>,
-    /// Per chain, the position of each vertex along it.
-    along: Vec<Vec<f64>>,
     /// Per slider, the quads around its vertex.
     quads: Rows<u32>,
     /// Sliders by colour: two of one colour share no quad (so neither bounds the other).
     colours: Vec<Vec<u32>>,
 }
 
-/// A vertex the template put at parameter `s` of its piece must be there to within this
-/// (relative to the piece's size), or its chain is left alone.
-const ON_PATH: f64 = 1e-9;
-
 impl Sliders {
-    /// The boundary vertices of `remesh`'s quad mesh, from its adapted M edges: each G' edge's
-    /// pieces sorted along its curve, their template points at `i / 2k`.
+    /// The boundary vertices of `remesh`'s quad mesh, on its [`Remesh::boundary_chains`]: every
+    /// vertex of a chain but its two ends.
     pub fn new(remesh: &Remesh) -> Self {
-        let Remesh {
-            dt,
-            elements,
-            mesh,
-            edge_curves,
-            ..
-        } = remesh;
-        let t = &dt.triangulation;
-        let per_edge = 2 * mesh.level() as usize;
-        let mut by_graph_edge: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
-        for (i, ec) in edge_curves.iter().enumerate() {
-            by_graph_edge.entry(ec.graph_edge).or_default().push(i);
-        }
-        let mut chains = Vec::new();
-        for (_, mut list) in by_graph_edge {
-            let lo = |i: &usize| edge_curves[*i].parameters[0].min(edge_curves[*i].parameters[1]);
-            list.sort_by(|a, b| lo(a).total_cmp(&lo(b)));
-            let mut chain = Chain::default();
-            for i in list {
-                let ec = &edge_curves[i];
-                let mut vertices = mesh.edge_vertices(t, elements, ec.edge);
-                let mut path = ec.path();
-                if ec.parameters[0] > ec.parameters[1] {
-                    vertices.reverse();
-                    path = path.reversed();
-                }
-                let size = path.control[0].distance_squared(path.control[3]).sqrt();
-                let on_path = vertices.iter().enumerate().all(|(k, &v)| {
-                    let s = k as f64 / per_edge as f64;
-                    path.eval(s)
-                        .distance_squared(mesh.vertices[v as usize])
-                        .sqrt()
-                        <= ON_PATH * (1.0 + size)
-                });
-                let continues = chain.vertices.last().is_none_or(|&v| v == vertices[0]);
-                if !on_path || !continues {
-                    // A gap or a piece off its path: what came before is a chain of its own.
-                    chains.push(std::mem::take(&mut chain));
-                    if !on_path {
-                        continue;
-                    }
-                }
-                if chain.vertices.is_empty() {
-                    chain.vertices.push(vertices[0]);
-                }
-                chain.vertices.extend_from_slice(&vertices[1..]);
-                chain.pieces.push(path);
-            }
-            chains.push(chain);
-        }
+        let mesh = &remesh.mesh;
+        let mut chains = remesh.boundary_chains();
         chains.retain(|c| c.vertices.len() >= 3);
-        let along: Vec<Vec<f64>> = chains
-            .iter()
-            .map(|c| {
-                (0..c.vertices.len())
-                    .map(|j| j as f64 / per_edge as f64)
-                    .collect()
-            })
-            .collect();
         let around = vertex_quads(mesh);
         let mut slot = Vec::new();
         let mut quads = Rows::new();
@@ -125,10 +46,14 @@ impl Sliders {
         Self {
             chains,
             slot,
-            along,
             quads,
             colours,
         }
+    }
+
+    /// The chains, each vertex where the sliding left it along its chain.
+    pub fn into_chains(self) -> Vec<BoundaryChain> {
+        self.chains
     }
 
     /// Number of sliding vertices.
@@ -171,7 +96,7 @@ impl Sliders {
     /// Slider `i`'s position along its chain, and its neighbours' on either side.
     pub fn gap(&self, i: usize) -> [f64; 3] {
         let (c, j) = self.slot[i];
-        let along = &self.along[c as usize];
+        let along = &self.chains[c as usize].along;
         let j = j as usize;
         [along[j - 1], along[j], along[j + 1]]
     }
@@ -201,7 +126,7 @@ impl Sliders {
     /// Puts slider `i` at `along` (not checked against its neighbours) and returns its point.
     pub fn place(&mut self, i: usize, along: f64) -> Point {
         let (c, j) = self.slot[i];
-        self.along[c as usize][j as usize] = along;
+        self.chains[c as usize].along[j as usize] = along;
         self.point(i, along)
     }
 
@@ -220,8 +145,9 @@ impl Sliders {
                     .collect();
                 for (i, along, p, before, after) in moves {
                     let (c, j) = self.slot[i as usize];
-                    self.along[c as usize][j as usize] = along;
-                    vertices[self.chains[c as usize].vertices[j as usize] as usize] = p;
+                    let chain = &mut self.chains[c as usize];
+                    chain.along[j as usize] = along;
+                    vertices[chain.vertices[j as usize] as usize] = p;
                     gained += before - after;
                     total += before;
                 }
@@ -251,12 +177,12 @@ impl Sliders {
                 continue;
             }
             let (c, j) = self.slot[i];
-            let (chain, along) = (&self.chains[c as usize], &mut self.along[c as usize]);
+            let chain = &mut self.chains[c as usize];
             let v = chain.vertices[j as usize] as usize;
-            let (lo, hi) = (along[j as usize - 1], along[j as usize + 1]);
+            let (lo, hi) = (chain.along[j as usize - 1], chain.along[j as usize + 1]);
             let margin = 0.05 * (hi - lo);
             let (lo, hi) = (lo + margin, hi - margin);
-            let start = (along[j as usize], vertices[v]);
+            let start = (chain.along[j as usize], vertices[v]);
             // Where the slider at `a` beats `best`: its value there.
             let mut above = |a: f64, best: (f64, f64)| {
                 vertices[v] = chain.point(a);
@@ -290,7 +216,7 @@ impl Sliders {
                 vertices[v] = start.1;
             } else {
                 vertices[v] = chain.point(at);
-                along[j as usize] = at;
+                chain.along[j as usize] = at;
                 moved += 1;
             }
         }
@@ -306,7 +232,8 @@ impl Sliders {
         setup: &Setup<'_>,
     ) -> Option<(u32, f64, Point, f64, f64)> {
         let (c, j) = self.slot[i];
-        let (chain, along) = (&self.chains[c as usize], &self.along[c as usize]);
+        let chain = &self.chains[c as usize];
+        let along = &chain.along;
         let v = chain.vertices[j as usize];
         let (lo, hi) = (along[j as usize - 1], along[j as usize + 1]);
         // Stay clear of the neighbours: a vertex on top of one would make a degenerate quad.

@@ -39,6 +39,7 @@
 //! ```
 
 mod adapt;
+mod chains;
 mod density;
 mod dt;
 mod mesh;
@@ -47,6 +48,7 @@ mod patch;
 mod template;
 
 pub use adapt::{adapt, adapt_within, AdaptReport, EdgeCurve, LOCAL_ROUNDS, POOR_SCALED_JACOBIAN};
+pub use chains::BoundaryChain;
 pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
 pub use dt::{DensityOptions, RegionTriangulation, BOUNDARY_CLEARANCE, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};

@@ -23,6 +23,7 @@
 //! assert_eq!(quad::shape(&clockwise), 1.0);
 //! ```
 
+pub mod curved;
 pub mod quad;
 pub mod tri;
 

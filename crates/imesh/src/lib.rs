@@ -30,7 +30,7 @@ use imesh_curves::{
     SimplifyOptions, TipOptions,
 };
 use imesh_geom::{RefineOptions, StopReason, TriangleId, Triangulation, VertexId};
-use imesh_io::SegmentedMeshData;
+use imesh_io::{SecondOrder, SegmentedMeshData};
 use imesh_optim::{optimise, Method, Metric, OptimOptions};
 use imesh_quad::{remesh, DensityOptions, Pairing, QuadOptions};
 use imesh_quality::{
@@ -335,6 +335,10 @@ pub struct MeshOptions {
     pub pairing: PairingMethod,
     /// Element kind.
     pub elements: Elements,
+    /// Element order: 1 (linear), or 2 (a node in the middle of every side, on the boundary
+    /// curve where the side follows one, and one at each quad's centre: 9-node quads and
+    /// 6-node triangles, 8-node quads in Abaqus files).
+    pub order: u32,
     /// How the quads are optimised.
     pub optimizer: OptimizerMethod,
     /// The quality the optimiser maximises.
@@ -381,6 +385,7 @@ impl Default for MeshOptions {
             template_level: 1,
             pairing: PairingMethod::Matching,
             elements: Elements::Quad,
+            order: 1,
             optimizer: OptimizerMethod::Local,
             metric: MetricName::ShapeAndSize,
             global_iterations: OptimOptions::default().global_iterations,
@@ -541,6 +546,17 @@ pub struct Counts {
     pub quads: usize,
     /// Triangles of the output mesh.
     pub triangles: usize,
+    /// Nodes of the output mesh: its vertices, and with `--order 2` the side middles and quad
+    /// centres.
+    pub nodes: usize,
+    /// Element sides whose middle node lies off the straight side, on a boundary curve or part
+    /// of the way there (`--order 2`, quads).
+    pub curved_sides: usize,
+    /// Of those, sides whose middle node keeps only a half or a quarter of the curve's offset:
+    /// the whole would have bent a quad too far ([`imesh_io::CURVED_JACOBIAN_SHARE`]).
+    pub damped_sides: usize,
+    /// Sides along a curve left straight: even a quarter of its offset bent a quad too far.
+    pub straightened_sides: usize,
 }
 
 /// Quality statistics of the output mesh: quads or triangles.
@@ -1012,6 +1028,9 @@ impl Pipeline {
         // (x · W) / w' is exact at x = 0 and x = w': the border stays the border.
         let scale = |v: &mut [f64; 2]| *v = [v[0] * w / cw, v[1] * h / ch];
         mesh.vertices.iter_mut().for_each(scale);
+        if let Some(so) = &mut mesh.second_order {
+            so.points.iter_mut().for_each(scale);
+        }
         // The stage pictures too: drawn over the image's frame, on the reduced labels stretched
         // to it (the cells are what was meshed).
         for stage in &mut result.stages {
@@ -1164,7 +1183,7 @@ impl Pipeline {
             (Vec::new(), Vec::new(), Vec::new(), c_edge_lines(&segmented))
         });
         let mut optimised = None;
-        let (vertices, elements, labels) = match curves {
+        let (vertices, elements, labels, curved) = match curves {
             None => self.triangles(&mut segmented, &mut counts, &mut seconds)?,
             Some(curves) => self.quads(
                 curves,
@@ -1185,7 +1204,7 @@ impl Pipeline {
         });
         let check = Instant::now();
         self.stage(Stage::Check);
-        let mesh = SegmentedMeshData {
+        let mut mesh = SegmentedMeshData {
             vertices,
             elements,
             labels,
@@ -1193,7 +1212,16 @@ impl Pipeline {
             label_colours: grid.regions().iter().map(|r| r.colour).collect(),
             width: w,
             height: h,
+            second_order: None,
         };
+        if o.order == 2 {
+            let so = SecondOrder::new(&mesh, &curved);
+            counts.curved_sides = so.curved;
+            counts.damped_sides = so.damped;
+            counts.straightened_sides = so.straightened;
+            mesh.second_order = Some(so);
+        }
+        counts.nodes = mesh.node_count();
         counts.vertices = mesh.vertices.len();
         counts.elements = mesh.elements.len();
         counts.quads = mesh
@@ -1296,7 +1324,7 @@ impl Pipeline {
         };
         let (vertices, triangles, labels) = segmented.arrays();
         let elements = triangles.iter().map(|&t| Element::Triangle(t)).collect();
-        Ok((vertices, elements, labels))
+        Ok((vertices, elements, labels, Vec::new()))
     }
 
     /// The curve stage of the quad output: the boundary graph G of the partition `label` of
@@ -1647,7 +1675,18 @@ impl Pipeline {
         });
         let vertices = r.mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
         let elements = r.mesh.quads.iter().map(|&q| Element::Quad(q)).collect();
-        Ok((vertices, elements, r.mesh.labels))
+        // The middle of each quad side along a boundary curve, where the optimiser's sliding left
+        // its two ends on the curve (second order).
+        let curved = if o.order == 2 {
+            let chains = optimisation.boundary.unwrap_or_else(|| r.boundary_chains());
+            chains
+                .iter()
+                .flat_map(|c| c.middles().map(|(e, p)| (e, [p.x, p.y])))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Ok((vertices, elements, r.mesh.labels, curved))
     }
 
     /// The refinement's point cap: the user's, and never more than the element limit (every
@@ -1734,6 +1773,12 @@ impl Pipeline {
                 o.template_level
             )));
         }
+        if !(1..=2).contains(&o.order) {
+            return Err(PipelineError::Options(format!(
+                "element order {} is not made: give 1 (linear) or 2 (quadratic)",
+                o.order
+            )));
+        }
         if let Some(r) = o.majority.filter(|&r| r > MAX_MAJORITY) {
             return Err(PipelineError::Options(format!(
                 "the majority filter radius {r} is too large: give 0 to {MAX_MAJORITY} pixels \
@@ -1806,7 +1851,14 @@ impl MeshOptions {
 }
 
 /// Vertices, elements and labels of a mesh.
-type MeshArrays = (Vec<[f64; 2]>, Vec<Element>, Vec<u32>);
+/// The output mesh's vertices, elements and labels, and the points on the boundary curves where
+/// second-order sides put their middle nodes.
+type MeshArrays = (
+    Vec<[f64; 2]>,
+    Vec<Element>,
+    Vec<u32>,
+    Vec<([u32; 2], [f64; 2])>,
+);
 
 /// How many labels of `grid` have a pixel.
 fn labels_present(grid: &LabelGrid) -> usize {
@@ -2075,7 +2127,8 @@ pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
 }
 
 /// [`label_agreement`], and how each label of `grid` comes out in `mesh` (whose labels are
-/// `grid`'s): its pixels, the area of its elements, their count and its own agreement.
+/// `grid`'s): its pixels, the area of its elements (curved, in a second-order mesh), their count
+/// and its own agreement (of the elements' corners).
 ///
 /// ```
 /// use imesh::region_fidelity;
@@ -2090,7 +2143,7 @@ pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
 ///     elements: vec![Element::Quad([0, 1, 4, 3]), Element::Quad([1, 2, 5, 4])],
 ///     labels: vec![0, 0], // the second pixel meshed with the first's label
 ///     label_names: grid.regions().iter().map(|r| r.name.clone()).collect(),
-///     label_colours: vec![[0; 3]; 2], width: 2, height: 1,
+///     label_colours: vec![[0; 3]; 2], width: 2, height: 1, second_order: None,
 /// };
 /// let (agreement, regions) = region_fidelity(&mesh, &grid);
 /// assert_eq!(agreement, 0.5);
@@ -2098,7 +2151,24 @@ pub fn label_agreement(mesh: &SegmentedMeshData, grid: &LabelGrid) -> f64 {
 /// assert_eq!((regions[1].pixels, regions[1].elements, regions[1].agreement), (1, 0, 0.0));
 /// ```
 pub fn region_fidelity(mesh: &SegmentedMeshData, grid: &LabelGrid) -> (f64, Vec<RegionFidelity>) {
-    agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid)
+    let (agreement, mut regions) = agreement(&mesh.vertices, &mesh.elements, &mesh.labels, grid);
+    curved_areas(mesh, &mesh.labels, &mut regions);
+    (agreement, regions)
+}
+
+/// A second-order mesh's curved sides move area between the labels on either side: each
+/// label's area becomes its elements' curved area (`labels`: the elements' labels as numbered
+/// in `regions`); the agreement stays that of the corners.
+fn curved_areas(mesh: &SegmentedMeshData, labels: &[u32], regions: &mut [RegionFidelity]) {
+    if mesh.second_order.is_none() {
+        return;
+    }
+    regions.iter_mut().for_each(|r| r.area_px = 0.0);
+    for (i, &l) in labels.iter().enumerate() {
+        if let Some(r) = regions.get_mut(l as usize) {
+            r.area_px += mesh.element_area(i);
+        }
+    }
 }
 
 /// Validates a mesh on the image domain `w × h` (conforming, exact area, no inverted element,
@@ -2168,7 +2238,9 @@ fn agreement_with_original(
         .iter()
         .map(|&l| original_label.get(l as usize).copied().unwrap_or(u32::MAX))
         .collect();
-    agreement(&mesh.vertices, &mesh.elements, &labels, original)
+    let (agreement, mut regions) = agreement(&mesh.vertices, &mesh.elements, &labels, original);
+    curved_areas(mesh, &labels, &mut regions);
+    (agreement, regions)
 }
 
 /// Pixels counted per parallel task by [`agreement`].

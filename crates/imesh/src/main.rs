@@ -173,6 +173,11 @@ struct MeshFlags {
     /// Element kind: quad (all-quad mesh) or tri (the Imesh triangle mesh) [default: quad].
     #[arg(long)]
     elements: Option<Elements>,
+    /// Element order: 1 (linear) or 2 (quadratic: a node in the middle of every side, on the
+    /// boundary curve where the side follows one, and one at each quad's centre; 9-node quads
+    /// and 6-node triangles, 8-node quads in .inp) [default: 1].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=2))]
+    order: Option<u32>,
     /// Quad optimisation: local (control points, block by block), global (the paper's single
     /// Powell run; slow), laplacian or vertex (baselines), none [default: local].
     #[arg(long)]
@@ -287,6 +292,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     if let Some(k) = args.template_level {
         o.template_level = k;
     }
+    if let Some(k) = args.order {
+        o.order = k;
+    }
     if let Some(p) = args.pairing {
         o.pairing = p;
     }
@@ -362,6 +370,23 @@ fn format_of(output: &Path) -> Result<String, String> {
             output.display()
         ))
     }
+}
+
+/// What `--order 2` made: the node count, and the sides that follow the boundary curves.
+fn second_order_note(c: &imesh::Counts) -> String {
+    let mut note = format!(
+        "second order: {} nodes; {} side{} bent along the boundary curves",
+        c.nodes,
+        c.curved_sides,
+        if c.curved_sides == 1 { "" } else { "s" }
+    );
+    if c.damped_sides + c.straightened_sides > 0 {
+        note += &format!(
+            " ({} of them only part of the way and {} left straight, so that no quad's Jacobian falls under half its straight self's)",
+            c.damped_sides, c.straightened_sides
+        );
+    }
+    note
 }
 
 /// `format` (a name of [`FORMATS`]) as [`write_mesh`] takes it: `msh22` for a .msh output of
@@ -460,6 +485,7 @@ fn write_stages(
             vertices: stage.vertices.clone(),
             elements: stage.elements.clone(),
             labels: stage.labels.clone(),
+            second_order: None,
             ..mesh.clone()
         };
         let options = SvgOptions {
@@ -693,6 +719,9 @@ fn mesh(args: &MeshArgs) -> Result<(), String> {
                     corner.angle_deg, corner.at[0], corner.at[1]
                 );
             }
+        }
+        if c.nodes > c.vertices {
+            println!("{}", second_order_note(c));
         }
         if c.blunted_tips > 0 {
             println!(

@@ -464,6 +464,7 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
         (&["mesh", image, "--min-angle", "40"], "34"),
         (&["mesh", image, "--elements", "hex"], "quad"),
         (&["mesh", image, "--template-level", "9"], "1 to 8"),
+        (&["mesh", image, "--order", "3"], "1..=2"),
         (&["mesh", image, "--tolerance=-1"], "tolerance"),
         (
             &["mesh", image, "--pairing", "best"],
@@ -752,10 +753,14 @@ fn the_histogram_shows_quality_before_and_after_optimisation() {
 fn quality_measures_a_written_mesh_as_the_report_did() {
     let dir = tempfile::tempdir().unwrap();
     let image = fixture("skimage-coins.png");
-    for (name, elements, version) in [
-        ("m.msh", "quad", "4.1"),
-        ("m22.msh", "tri", "2.2"),
-        ("m.vtk", "tri", ""),
+    // Second-order files are read as their elements' corners: the same statistics.
+    for (name, elements, version, order) in [
+        ("m.msh", "quad", "4.1", "1"),
+        ("m22.msh", "tri", "2.2", "1"),
+        ("m.vtk", "tri", "", "1"),
+        ("q2.msh", "quad", "4.1", "2"),
+        ("q2.vtk", "quad", "", "2"),
+        ("t2.msh", "tri", "2.2", "2"),
     ] {
         let mut args = vec![
             "mesh",
@@ -764,6 +769,8 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
             name,
             "--elements",
             elements,
+            "--order",
+            order,
             "--report",
             "r.json",
             "-q",
@@ -777,7 +784,16 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
                 .unwrap();
         let out = imesh_ok(&["quality", name, "--json"], dir.path());
         let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(measured["vertices"], report["counts"]["vertices"], "{name}");
+        assert_eq!(measured["vertices"], report["counts"]["nodes"], "{name}");
+        if order == "1" {
+            assert_eq!(
+                report["counts"]["nodes"], report["counts"]["vertices"],
+                "{name}"
+            );
+        } else {
+            let (nodes, vertices) = (&report["counts"]["nodes"], &report["counts"]["vertices"]);
+            assert!(nodes.as_u64() > vertices.as_u64(), "{name}");
+        }
         assert_eq!(measured["quads"], report["counts"]["quads"], "{name}");
         assert_eq!(
             measured["triangles"], report["counts"]["triangles"],
@@ -1020,4 +1036,42 @@ fn the_command_says_when_the_clean_up_drops_a_label() {
         out.status.success() && said.contains("2 labels") && !said.contains("no elements"),
         "{said}"
     );
+}
+
+#[test]
+fn order_two_writes_quadratic_elements_and_says_what_bent() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = fixture("skimage-coins.png");
+    let out = imesh_ok(
+        &[
+            "mesh",
+            image.to_str().unwrap(),
+            "--order",
+            "2",
+            "-o",
+            "c.inp",
+            "--report",
+            "r.json",
+        ],
+        dir.path(),
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let c = &report["counts"];
+    assert_eq!(report["options"]["order"], 2);
+    let note = format!(
+        "second order: {} nodes; {} sides bent along the boundary curves",
+        c["nodes"], c["curved_sides"]
+    );
+    assert!(stdout.contains(&note), "{stdout}");
+    let inp = std::fs::read_to_string(dir.path().join("c.inp")).unwrap();
+    // 8-node quads: an id and eight nodes per element line.
+    let lines: Vec<&str> = inp.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("*Element, type=CPS8"))
+        .unwrap();
+    assert_eq!(lines[at + 1].split(", ").count(), 9);
+    assert!(!inp.contains("type=CPS4"));
 }

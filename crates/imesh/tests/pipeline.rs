@@ -560,3 +560,91 @@ fn sharp_tips_are_cut_unless_kept() {
     // The boundary moved by the cut's depth at most, and the report's fidelity says so.
     assert!(cut.fidelity.boundary_hausdorff_px >= kept.fidelity.boundary_hausdorff_px);
 }
+
+/// `--order 2` on a fixture of curved boundaries, meshed on its pixels and on a reduced grid
+/// (whose mesh is scaled back, the second-order nodes too): the linear mesh is the order-1 mesh,
+/// every quad keeps its Jacobian above half its straight self's everywhere (proved by the
+/// Bernstein bound), the curved quads cover the image exactly, only sides between two labels
+/// bend, and the report counts what was made.
+#[test]
+fn second_order_meshes_bend_the_boundary_sides_and_stay_valid() {
+    let image = image::open(support::fixture("skimage-coins.png")).expect("the coins load");
+    for reduction in [1, 2] {
+        let run = |order: u32| {
+            Pipeline::new(MeshOptions {
+                order,
+                reduction: Some(reduction),
+                ..Default::default()
+            })
+            .run_image(&image)
+            .unwrap()
+        };
+        let (linear, quadratic) = (run(1), run(2));
+        let (mesh, report) = (&quadratic.mesh, &quadratic.report);
+        assert_eq!(mesh.vertices, linear.mesh.vertices);
+        assert_eq!(mesh.elements, linear.mesh.elements);
+        assert_eq!(mesh.labels, linear.mesh.labels);
+        let so = mesh.second_order.as_ref().expect("second-order nodes");
+        let c = &report.counts;
+        assert_eq!(c.nodes, mesh.node_count());
+        assert_eq!(c.nodes, c.vertices + so.edges.len() + c.quads);
+        assert_eq!((c.curved_sides, c.damped_sides), (so.curved, so.damped));
+        assert!(c.curved_sides > 200, "{} sides bent", c.curved_sides);
+        assert!(c.straightened_sides * 50 < c.curved_sides);
+        let (w, h) = (f64::from(mesh.width), f64::from(mesh.height));
+        let mut total = 0.0;
+        let between_labels: std::collections::HashSet<[u32; 2]> = imesh_io::boundaries(mesh)
+            .into_iter()
+            .filter(|b| b.labels[1] != imesh_io::OUTSIDE)
+            .flat_map(|b| b.edges)
+            .collect();
+        let mut bent = 0;
+        for (i, e) in mesh.elements.iter().enumerate() {
+            let imesh_quality::Element::Quad(corners) = *e else {
+                panic!("quads only");
+            };
+            let mut q = [[0.0; 2]; 9];
+            for k in 0..4 {
+                q[k] = mesh.vertices[corners[k] as usize];
+                q[4 + k] = mesh.node(so.sides[i][k] as usize);
+                let (a, b) = (q[k], mesh.vertices[corners[(k + 1) % 4] as usize]);
+                let straight = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+                let d = ((q[4 + k][0] - straight[0]).powi(2) + (q[4 + k][1] - straight[1]).powi(2))
+                    .sqrt();
+                if d > 1e-9 {
+                    let (u, v) = (corners[k], corners[(k + 1) % 4]);
+                    assert!(
+                        between_labels.contains(&[u.min(v), u.max(v)]),
+                        "quad {i} side {k}: {:?} → {:?}, middle {:?} off by {d}",
+                        a,
+                        b,
+                        q[4 + k]
+                    );
+                    bent += 1;
+                }
+            }
+            q[8] = mesh.node(so.centres[i] as usize);
+            let [a, b, cc, d] = [q[0], q[1], q[2], q[3]];
+            let cross = |u: [f64; 2], v: [f64; 2]| u[0] * v[1] - u[1] * v[0];
+            let sub = |u: [f64; 2], v: [f64; 2]| [u[0] - v[0], u[1] - v[1]];
+            let straight = [
+                cross(sub(b, a), sub(d, a)),
+                cross(sub(b, a), sub(cc, b)),
+                cross(sub(cc, d), sub(d, a)),
+                cross(sub(cc, d), sub(cc, b)),
+            ]
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+            assert!(
+                imesh_quality::curved::jacobian_at_least(&q, 0.5 * straight),
+                "quad {i} (reduction {reduction})"
+            );
+            total += mesh.element_area(i);
+        }
+        // Each bent side counted once from either quad.
+        assert_eq!(bent, 2 * so.curved);
+        assert!((total / (w * h) - 1.0).abs() < 1e-9, "{total} of {}", w * h);
+        let regions: f64 = report.fidelity.regions.iter().map(|r| r.area_px).sum();
+        assert!((regions / (w * h) - 1.0).abs() < 1e-9);
+    }
+}
