@@ -113,20 +113,14 @@ impl SegmentedMeshData {
     /// The area element `i` covers: its corners' polygon, or with second-order nodes a quad's
     /// curved area ([`imesh_quality::curved::area`]; a triangle's sides stay straight).
     pub fn element_area(&self, i: usize) -> f64 {
-        let e = &self.elements[i];
-        let corner = |v: &u32| self.vertices[*v as usize];
-        match (e, &self.second_order) {
-            (Element::Quad(c), Some(s)) => {
-                let node = |k: u32| self.node(k as usize);
-                let mut q = [[0.0; 2]; 9];
-                for k in 0..4 {
-                    q[k] = corner(&c[k]);
-                    q[4 + k] = node(s.sides[i][k]);
-                }
-                q[8] = node(s.centres[i]);
-                imesh_quality::curved::area(&q)
+        match self.second_order.as_ref().and_then(|s| s.quad9(self, i)) {
+            Some(q) => imesh_quality::curved::area(&q),
+            None => {
+                let corner = |v: &u32| self.vertices[*v as usize];
+                let corners: Vec<[f64; 2]> =
+                    self.elements[i].corners().iter().map(corner).collect();
+                imesh_quality::signed_area(&corners)
             }
-            _ => imesh_quality::signed_area(&e.corners().iter().map(corner).collect::<Vec<_>>()),
         }
     }
 

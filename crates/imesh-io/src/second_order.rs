@@ -4,7 +4,7 @@
 //! whose plane elements have no 9-node quad): the centre node is the one that makes the
 //! 9-node quad the 8-node one, so both files describe the same elements.
 
-use imesh_quality::curved::{jacobian_at_least, serendipity_centre};
+use imesh_quality::curved::{keeps_share_of_straight, serendipity_centre, Quad9};
 use imesh_quality::Element;
 use rayon::prelude::*;
 
@@ -217,46 +217,33 @@ impl SecondOrder {
     /// Puts every quad's centre node where the 8-node quad of its corners and middles has it.
     fn place_centres(&mut self, mesh: &SegmentedMeshData, n: u32) {
         for i in 0..mesh.elements.len() {
-            if let Some(q) = self.quad9(mesh, n, i) {
+            if let Some(q) = self.quad9(mesh, i) {
                 self.points[(self.centres[i] - n) as usize] = q[8];
             }
         }
     }
 
-    /// Element `i`'s nine nodes, the centre the serendipity one (`None` for a triangle).
-    fn quad9(&self, mesh: &SegmentedMeshData, n: u32, i: usize) -> Option<[[f64; 2]; 9]> {
+    /// Element `i`'s nine nodes (Gmsh's order: corners, side middles, centre), the centre the
+    /// serendipity one its node holds; `None` for a triangle.
+    pub fn quad9(&self, mesh: &SegmentedMeshData, i: usize) -> Option<Quad9> {
         let Element::Quad(c) = mesh.elements[i] else {
             return None;
         };
+        let n = mesh.vertices.len();
         let corners = c.map(|v| mesh.vertices[v as usize]);
-        let middles = self.sides[i].map(|node| self.points[(node - n) as usize]);
-        let centre = serendipity_centre(&corners, &middles);
+        let middles = self.sides[i].map(|node| self.points[node as usize - n]);
         let mut q = [[0.0; 2]; 9];
         q[..4].copy_from_slice(&corners);
         q[4..8].copy_from_slice(&middles);
-        q[8] = centre;
+        q[8] = serendipity_centre(&corners, &middles);
         Some(q)
     }
 
     /// Whether element `i` keeps its Jacobian above [`CURVED_JACOBIAN_SHARE`] of its straight
     /// self's smallest corner value (a triangle, always straight, does).
     fn fits(&self, mesh: &SegmentedMeshData, i: usize) -> bool {
-        let n = mesh.vertices.len() as u32;
-        let Some(q) = self.quad9(mesh, n, i) else {
-            return true;
-        };
-        let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
-        let cross = |u: [f64; 2], v: [f64; 2]| u[0] * v[1] - u[1] * v[0];
-        let sub = |u: [f64; 2], v: [f64; 2]| [u[0] - v[0], u[1] - v[1]];
-        let straight = [
-            cross(sub(b, a), sub(d, a)),
-            cross(sub(b, a), sub(c, b)),
-            cross(sub(c, d), sub(d, a)),
-            cross(sub(c, d), sub(c, b)),
-        ]
-        .into_iter()
-        .fold(f64::INFINITY, f64::min);
-        jacobian_at_least(&q, CURVED_JACOBIAN_SHARE * straight)
+        self.quad9(mesh, i)
+            .is_none_or(|q| keeps_share_of_straight(&q, CURVED_JACOBIAN_SHARE))
     }
 }
 
@@ -304,22 +291,6 @@ mod tests {
             height: h,
             second_order: None,
         }
-    }
-
-    /// The 9 nodes of quad `i`.
-    fn nodes(mesh: &SegmentedMeshData, so: &SecondOrder, i: usize) -> [[f64; 2]; 9] {
-        let Element::Quad(c) = mesh.elements[i] else {
-            unreachable!("quads only")
-        };
-        let n = mesh.vertices.len();
-        let node = |k: u32| so.points[k as usize - n];
-        let mut q = [[0.0; 2]; 9];
-        for k in 0..4 {
-            q[k] = mesh.vertices[c[k] as usize];
-            q[4 + k] = node(so.sides[i][k]);
-        }
-        q[8] = node(so.centres[i]);
-        q
     }
 
     proptest! {
@@ -385,7 +356,7 @@ mod tests {
                         }
                     }
                     Element::Quad(_) => {
-                        let q = nodes(&mesh, &so, i);
+                        let q = so.quad9(&mesh, i).unwrap();
                         let coefficients = jacobian_coefficients(&q);
                         let corners = [coefficients[0], coefficients[3], coefficients[12], coefficients[15]];
                         let straight = {

@@ -456,10 +456,9 @@ proptest! {
     }
 }
 
-#[test]
-fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
-    // Triangles, and the same grid's squares as quads.
-    let triangles = grid_mesh(3, 2);
+/// The grid of [`grid_mesh`] with its squares as quads.
+fn quad_grid(w: u32, h: u32) -> SegmentedMeshData {
+    let triangles = grid_mesh(w, h);
     let mut quads = triangles.clone();
     quads.elements = triangles
         .elements
@@ -472,7 +471,13 @@ fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
         })
         .collect();
     quads.labels = triangles.labels.iter().step_by(2).copied().collect();
-    for mesh in [triangles, quads] {
+    quads
+}
+
+#[test]
+fn abaqus_sides_have_node_sets_and_surfaces_of_element_faces_on_them() {
+    // Triangles, and the same grid's squares as quads.
+    for mesh in [grid_mesh(3, 2), quad_grid(3, 2)] {
         abaqus_sides_of(&mesh);
         // Second order: the sides' middle nodes join the sides' node sets.
         let second = SegmentedMeshData {
@@ -573,19 +578,7 @@ fn legacy_vtk_counts_and_labels() {
 /// The 3 × 2 grid of [`grid_mesh`] with its squares as quads, in second order, the side
 /// between the first two columns' top quads bent 0.2 to the right: the point it was given.
 fn second_order_quads() -> (SegmentedMeshData, [f64; 2]) {
-    let triangles = grid_mesh(3, 2);
-    let mut mesh = triangles.clone();
-    mesh.elements = triangles
-        .elements
-        .chunks(2)
-        .map(|pair| match pair {
-            [Element::Triangle([a, b, c]), Element::Triangle([_, _, d])] => {
-                Element::Quad([*a, *b, *c, *d])
-            }
-            _ => unreachable!("grid_mesh gives triangles in pairs"),
-        })
-        .collect();
-    mesh.labels = triangles.labels.iter().step_by(2).copied().collect();
+    let mut mesh = quad_grid(3, 2);
     // Vertices 1 = (1, 0) and 5 = (1, 1).
     let bent = [1.2, 0.5];
     let so = SecondOrder::new(&mesh, &[([1, 5], bent)]);

@@ -719,7 +719,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     };
     let (repaired, repaired_sliders, quality_repaired) =
         if options.repair && matches!(options.method, Method::Local | Method::Vertex) {
-            let (descended, descended_sliders) = (mesh.vertices.clone(), sliders.clone());
+            let (descended, descended_along) = (mesh.vertices.clone(), sliders.positions());
             // The repair trades a quad's size for the corners of its neighbours: of the metric it
             // keeps only the start's worst (held to each quad's own, it left grass's worst shape
             // 0.136 → 0.106 and stardist's 0.312 → 0.302); a quad's shape and scaled Jacobian may
@@ -805,7 +805,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             // (on the fixtures it costs 0.001 of mean shape-and-size at most).
             if moved + raised > 0 && setup.energy(&mesh.vertices) > energy_before {
                 mesh.vertices = descended;
-                sliders = descended_sliders;
+                sliders.restore(descended_along);
                 (0, 0, 0)
             } else {
                 (moved, slid, raised)

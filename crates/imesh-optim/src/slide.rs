@@ -51,6 +51,20 @@ impl Sliders {
         }
     }
 
+    /// Where every chain's vertices are along it, to put them back with
+    /// [`Sliders::restore`].
+    pub fn positions(&self) -> Vec<Vec<f64>> {
+        self.chains.iter().map(|c| c.along.clone()).collect()
+    }
+
+    /// Puts the vertices back where [`Sliders::positions`] found them (the mesh's vertices are
+    /// the caller's to put back).
+    pub fn restore(&mut self, positions: Vec<Vec<f64>>) {
+        for (c, along) in self.chains.iter_mut().zip(positions) {
+            c.along = along;
+        }
+    }
+
     /// The chains, each vertex where the sliding left it along its chain.
     pub fn into_chains(self) -> Vec<BoundaryChain> {
         self.chains
@@ -296,10 +310,8 @@ mod tests {
     use crate::support;
     use imesh_quad::{remesh, QuadOptions};
 
-    /// On a disc's mesh: a slider's neighbours on its chain are the sliders numbered next to
-    /// it, standing where its gap says, or the chain's ends.
-    #[test]
-    fn a_sliders_neighbours_are_the_next_sliders_on_its_chain() {
+    /// A disc's quad mesh.
+    fn disc() -> imesh_quad::Remesh {
         let (w, h) = (24u32, 20u32);
         let labels = (0..w * h)
             .map(|i| {
@@ -308,7 +320,34 @@ mod tests {
             })
             .collect();
         let (_, s, curves) = support::simplified_with_curves(&support::grid(w, h, labels));
-        let r = remesh(&s.graph, &curves, &QuadOptions::default()).unwrap();
+        remesh(&s.graph, &curves, &QuadOptions::default()).unwrap()
+    }
+
+    /// Positions taken and restored put every slider back, and the chains handed out say so.
+    #[test]
+    fn restored_positions_put_the_sliders_back() {
+        let r = disc();
+        let mut sliders = Sliders::new(&r);
+        let start = sliders.positions();
+        for i in 0..sliders.len() {
+            let [lo, at, _] = sliders.gap(i);
+            sliders.place(i, 0.5 * (lo + at));
+        }
+        assert_ne!(sliders.positions(), start);
+        sliders.restore(start.clone());
+        assert_eq!(sliders.positions(), start);
+        let chains = sliders.into_chains();
+        assert_eq!(
+            chains.iter().map(|c| c.along.clone()).collect::<Vec<_>>(),
+            start
+        );
+    }
+
+    /// On a disc's mesh: a slider's neighbours on its chain are the sliders numbered next to
+    /// it, standing where its gap says, or the chain's ends.
+    #[test]
+    fn a_sliders_neighbours_are_the_next_sliders_on_its_chain() {
+        let r = disc();
         let sliders = Sliders::new(&r);
         let slider_of = sliders.slider_of_vertices(r.mesh.vertices.len());
         let (mut inner, mut ends) = (0, 0);

@@ -218,6 +218,28 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
             report.after.scaled_jacobian.min
         );
     }
+    // The chains handed back say where each boundary vertex ended, in order along its chain
+    // (what a second-order mesh bends its sides along); without sliding, none.
+    match &report.boundary {
+        None => assert!(!sliding, "{method:?}: no chains"),
+        Some(chains) => {
+            assert!(sliding, "{method:?}: chains without sliding");
+            assert_eq!(chains.len(), start.boundary_chains().len());
+            for c in chains {
+                for (&v, &a) in c.vertices.iter().zip(&c.along) {
+                    let d = c
+                        .point(a)
+                        .distance_squared(r.mesh.vertices[v as usize])
+                        .sqrt();
+                    assert!(
+                        d < 1e-9,
+                        "{method:?}: vertex {v} {d} from its place on its chain"
+                    );
+                }
+                assert!(c.along.windows(2).all(|w| w[0] < w[1]), "{method:?}");
+            }
+        }
+    }
     (r, report)
 }
 

@@ -141,6 +141,31 @@ fn quarters(c: &[f64; 16]) -> [[f64; 16]; 4] {
     out
 }
 
+/// Whether the Jacobian determinant of `q` stays at least `share` of the smallest corner value
+/// of the straight (bilinear) quad of the same corners, everywhere ([`jacobian_at_least`]): how
+/// far its bent sides may bend it.
+///
+/// ```
+/// use imesh_quality::curved::keeps_share_of_straight;
+/// // The unit square, its bottom side bent 0.2 inwards (smallest determinant 0.6).
+/// let q = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0],
+///          [0.5, 0.2], [1.0, 0.5], [0.5, 1.0], [0.0, 0.5], [0.5, 0.55]];
+/// assert!(keeps_share_of_straight(&q, 0.5));
+/// assert!(!keeps_share_of_straight(&q, 0.7));
+/// ```
+pub fn keeps_share_of_straight(q: &Quad9, share: f64) -> bool {
+    let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
+    let straight = [
+        cross(sub(b, a), sub(d, a)),
+        cross(sub(b, a), sub(c, b)),
+        cross(sub(c, d), sub(d, a)),
+        cross(sub(c, d), sub(c, b)),
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min);
+    jacobian_at_least(q, share * straight)
+}
+
 /// The area `q` covers: the integral of its Jacobian determinant over the unit square, the
 /// mean of its Bernstein coefficients (each basis function integrates to 1/16).
 ///
@@ -255,20 +280,22 @@ mod tests {
         (0..16).map(|k| c[k] * a[k % 4] * e[k / 4]).sum()
     }
 
+    /// The unit square with its middle nodes halfway and its centre in the middle.
+    const UNIT_SQUARE: Quad9 = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [1.0, 1.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [1.0, 0.5],
+        [0.5, 1.0],
+        [0.0, 0.5],
+        [0.5, 0.5],
+    ];
+
     fn jittered_quad() -> impl Strategy<Value = Quad9> {
         proptest::array::uniform9(proptest::array::uniform2(-0.2f64..0.2)).prop_map(|d| {
-            let base = [
-                [0.0, 0.0],
-                [1.0, 0.0],
-                [1.0, 1.0],
-                [0.0, 1.0],
-                [0.5, 0.0],
-                [1.0, 0.5],
-                [0.5, 1.0],
-                [0.0, 0.5],
-                [0.5, 0.5],
-            ];
-            let mut q = base;
+            let mut q = UNIT_SQUARE;
             for (p, d) in q.iter_mut().zip(d) {
                 p[0] += d[0];
                 p[1] += d[1];
@@ -372,17 +399,7 @@ mod tests {
     /// A side pushed across the element inverts it: the lower bound goes negative.
     #[test]
     fn a_side_bent_across_the_element_is_caught() {
-        let mut q: Quad9 = [
-            [0.0, 0.0],
-            [1.0, 0.0],
-            [1.0, 1.0],
-            [0.0, 1.0],
-            [0.5, 0.0],
-            [1.0, 0.5],
-            [0.5, 1.0],
-            [0.0, 0.5],
-            [0.5, 0.5],
-        ];
+        let mut q = UNIT_SQUARE;
         assert!(jacobian_bounds(&q)[0] > 0.0);
         q[4] = [0.5, 0.9];
         assert!(jacobian_bounds(&q)[0] < 0.0);

@@ -28,6 +28,11 @@ fn imesh_ok(args: &[&str], dir: &Path) -> Output {
     out
 }
 
+/// The JSON report `r.json` a run wrote in `dir`.
+fn read_report(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap()
+}
+
 /// The counts of an MSH 4.1 file: nodes, surface elements, physical surfaces, physical curves.
 fn msh_counts(text: &str) -> (usize, usize, usize, usize) {
     let lines: Vec<&str> = text.lines().collect();
@@ -288,8 +293,7 @@ fn pixel_size_and_origin_place_the_image_in_the_written_frame() {
     }
     // The image's bottom-left corner at the origin, 250 px of 0.5 and 2 units to the right and up.
     assert_eq!((lo, hi), ([-100.0, 25.5], [25.0, 525.5]));
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     assert_eq!(
         report["options"]["origin"],
         serde_json::json!([-100.0, 25.5])
@@ -627,8 +631,7 @@ fn a_config_file_sets_options_and_unknown_keys_are_refused() {
         ],
         dir.path(),
     );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     assert_eq!(report["options"]["te"], 0.3);
     assert_eq!(report["options"]["min_angle"], 22.0);
     let out = imesh(
@@ -730,8 +733,7 @@ fn the_histogram_shows_quality_before_and_after_optimisation() {
     let has = |c: [u8; 3]| picture.pixels().filter(|p| p.0 == c).count() > 200;
     assert!(has([150, 150, 150]) && has([40, 90, 200]));
     // The report carries the same histograms: every quad counted once, before and after.
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     let quads = report["counts"]["quads"].as_u64().unwrap();
     for key in [
         "shape_and_size_before",
@@ -779,9 +781,7 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
             args.extend(["--msh-version", version]);
         }
         imesh_ok(&args, dir.path());
-        let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
-                .unwrap();
+        let report: serde_json::Value = read_report(dir.path());
         let out = imesh_ok(&["quality", name, "--json"], dir.path());
         let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(measured["vertices"], report["counts"]["nodes"], "{name}");
@@ -857,8 +857,7 @@ fn stages_draws_every_step_of_the_pipeline() {
         ],
         dir.path(),
     );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     let mut names: Vec<String> = std::fs::read_dir(dir.path().join("stages"))
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
@@ -1006,8 +1005,7 @@ fn the_command_says_when_the_clean_up_drops_a_label() {
         "{said}"
     );
     assert!(said.contains("--majority 0 --min-width 0"), "{said}");
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     assert_eq!(report["counts"]["image_labels"], 2);
     assert_eq!(report["counts"]["meshed_labels"], 1);
     let out = imesh(
@@ -1056,8 +1054,7 @@ fn order_two_writes_quadratic_elements_and_says_what_bent() {
         dir.path(),
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let report: serde_json::Value = read_report(dir.path());
     let c = &report["counts"];
     assert_eq!(report["options"]["order"], 2);
     let note = format!(

@@ -19,20 +19,40 @@ fn strings(array: &serde_json::Value) -> Vec<&str> {
         .collect()
 }
 
-fn meshio_read(python: &str, file: &Path) -> serde_json::Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/read_mesh.py");
+/// What `tests/scripts/SCRIPT` prints (JSON) about `file`, run by `python`.
+fn python_json(python: &str, script: &str, file: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/scripts")
+        .join(script);
     let out = Command::new(python)
-        .arg(script)
+        .arg(&script)
         .arg(file)
         .output()
         .expect("the Python of IMESH_PYTHON runs");
     assert!(
         out.status.success(),
-        "meshio could not read {}: {}",
+        "{} could not read {}: {}",
+        script.display(),
         file.display(),
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("the script prints JSON")
+}
+
+/// Runs `imesh` with `args` and `--report r.json -q` in `dir`; the report.
+fn mesh_with_report(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
+        .args(args)
+        .args(["--report", "r.json", "-q"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "imesh {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap()
 }
 
 #[test]
@@ -62,32 +82,12 @@ fn meshio_reads_every_format_we_write() {
             } else {
                 &["--msh-version", version]
             };
-            let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
-                .args([
-                    "mesh",
-                    image.to_str().unwrap(),
-                    "-o",
-                    name,
-                    "--pixel-size",
-                    pixel,
-                    "--report",
-                    "r.json",
-                    "-q",
-                ])
-                .args(version)
-                .current_dir(dir.path())
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            let report: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
-                    .unwrap();
+            let mut args = vec!["mesh", image.to_str().unwrap(), "-o", name];
+            args.extend(["--pixel-size", pixel]);
+            args.extend(version);
+            let report = mesh_with_report(dir.path(), &args);
             let what = format!("{fixture} {name}");
-            let read = meshio_read(&python, &dir.path().join(name));
+            let read = python_json(&python, "read_mesh.py", &dir.path().join(name));
             assert_eq!(read["points"], report["counts"]["vertices"], "{what}");
             // The default mesh is all quads.
             assert_eq!(read["cells"]["quad"], report["counts"]["quads"], "{what}");
@@ -183,41 +183,13 @@ fn gmsh_opens_our_msh_with_the_same_physical_groups() {
         let image = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../fixtures/images")
             .join(fixture_name);
-        let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
-            .args([
-                "mesh",
-                image.to_str().unwrap(),
-                "-o",
-                "m.msh",
-                "--msh-version",
-                version,
-                "--report",
-                "r.json",
-                "-q",
-            ])
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        let args = ["mesh", image.to_str().unwrap(), "-o", "m.msh"];
+        let report = mesh_with_report(
+            dir.path(),
+            &[&args[..], &["--msh-version", version]].concat(),
         );
-        let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
-                .unwrap();
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/gmsh_read.py");
-        let read = Command::new(&python)
-            .arg(script)
-            .arg(dir.path().join("m.msh"))
-            .output()
-            .expect("the Python of IMESH_PYTHON runs");
-        assert!(
-            read.status.success(),
-            "Gmsh could not open the mesh of {fixture}: {}",
-            String::from_utf8_lossy(&read.stderr)
-        );
-        let seen: serde_json::Value = serde_json::from_slice(&read.stdout).unwrap();
+        // Gmsh opens it (or the script fails, and says why).
+        let seen = python_json(&python, "gmsh_read.py", &dir.path().join("m.msh"));
         assert_eq!(seen["nodes"], report["counts"]["vertices"], "{fixture}");
         assert_eq!(
             seen["elements"]["Quadrilateral 4"], report["counts"]["quads"],
@@ -297,35 +269,11 @@ fn second_order_files_open_as_valid_curved_quads() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
     for (name, version) in [("q.msh", "4.1"), ("q22.msh", "2.2"), ("q.vtu", "")] {
         let mut args = vec!["mesh", image.to_str().unwrap(), "--order", "2", "-o", name];
-        args.extend(["--report", "r.json", "-q"]);
         if !version.is_empty() {
             args.extend(["--msh-version", version]);
         }
-        let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
-            .args(&args)
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
-                .unwrap();
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/curved_check.py");
-        let read = Command::new(&python)
-            .arg(script)
-            .arg(dir.path().join(name))
-            .output()
-            .expect("the Python of IMESH_PYTHON runs");
-        assert!(
-            read.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&read.stderr)
-        );
-        let seen: serde_json::Value = serde_json::from_slice(&read.stdout).unwrap();
+        let report = mesh_with_report(dir.path(), &args);
+        let seen = python_json(&python, "curved_check.py", &dir.path().join(name));
         assert_eq!(seen["cells"]["quad9"], report["counts"]["quads"], "{name}");
         if version.is_empty() {
             assert!(seen["cells"]["line3"].is_null(), "{name}");
