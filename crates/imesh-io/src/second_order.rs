@@ -15,7 +15,8 @@ pub const NO_NODE: u32 = u32::MAX;
 
 /// A curved quad's Jacobian determinant must stay at least this share of its straight
 /// (bilinear) self's smallest corner value everywhere (proved by
-/// [`imesh_quality::curved::jacobian_at_least`]); otherwise its curved sides are straightened.
+/// [`imesh_quality::curved::keeps_share_of_straight`]); otherwise its curved sides are pulled
+/// back towards straight.
 pub const CURVED_JACOBIAN_SHARE: f64 = 0.5;
 
 /// A curve point closer than this share of its side's length to the side's line leaves the
@@ -79,88 +80,51 @@ impl SecondOrder {
     /// ```
     pub fn new(mesh: &SegmentedMeshData, curved: &[([u32; 2], [f64; 2])]) -> Self {
         let n = mesh.vertices.len() as u32;
-        let key = |[a, b]: [u32; 2]| [a.min(b), a.max(b)];
-        // Every side as (edge, element, side), sorted: an edge's sides are then consecutive.
-        let mut all: Vec<([u32; 2], u32, u8)> = Vec::with_capacity(4 * mesh.elements.len());
-        for (i, e) in mesh.elements.iter().enumerate() {
-            let c = e.corners();
-            for k in 0..c.len() {
-                all.push((key([c[k], c[(k + 1) % c.len()]]), i as u32, k as u8));
-            }
-        }
-        all.par_sort_unstable();
-        let mut sides = vec![[NO_NODE; 4]; mesh.elements.len()];
-        let mut edges: Vec<([u32; 2], u32)> = Vec::new();
-        // Per edge, whether only quads hold it (a curve point is offered to those alone).
-        let mut quads_only = Vec::new();
-        // Per edge, where its sides start in `all` (and the end, last).
-        let mut run_start = Vec::new();
-        let mut at = 0;
-        for run in all.chunk_by(|x, y| x.0 == y.0) {
-            let node = n + edges.len() as u32;
-            edges.push((run[0].0, node));
-            run_start.push(at);
-            at += run.len();
-            quads_only.push(
-                run.iter()
-                    .all(|&(_, i, _)| matches!(mesh.elements[i as usize], Element::Quad(_))),
-            );
-            for &(_, i, k) in run {
-                sides[i as usize][k as usize] = node;
-            }
-        }
-        run_start.push(at);
-        let vertex = |v: u32| mesh.vertices[v as usize];
-        let mut points: Vec<[f64; 2]> = edges
-            .iter()
-            .map(|&([a, b], _)| {
-                let (p, q) = (vertex(a), vertex(b));
-                [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]
-            })
-            .collect();
-        let straight = points.clone();
-        // Per side, the share of its curve point's offset from the straight middle kept.
-        let mut share = vec![0.0; edges.len()];
-        let mut offset = vec![[0.0; 2]; edges.len()];
-        for &(edge, p) in curved {
-            if let Ok(k) = edges.binary_search_by(|x| x.0.cmp(&key(edge))) {
-                let off = [p[0] - straight[k][0], p[1] - straight[k][1]];
-                // A point on the side's own line does not bend it.
-                let [a, b] = edges[k].0.map(vertex);
-                let along = [b[0] - a[0], b[1] - a[1]];
-                let length = along[0].hypot(along[1]);
-                let across = (off[0] * along[1] - off[1] * along[0]).abs() / length;
-                if quads_only[k] && off.iter().all(|x| x.is_finite()) && across > STRAIGHT * length
-                {
-                    points[k] = p;
-                    offset[k] = off;
-                    share[k] = 1.0;
-                }
-            }
-        }
-        let offered = share.iter().filter(|&&w| w > 0.0).count();
-        let mut centres = vec![NO_NODE; mesh.elements.len()];
-        let mut next = n + edges.len() as u32;
-        for (i, e) in mesh.elements.iter().enumerate() {
+        // 1. A middle node per side, halfway along it, and a centre node per quad.
+        let mut sides = Sides::of(mesh);
+        let straight = sides.straight_middles(mesh);
+        let mut so = SecondOrder {
+            points: straight.clone(),
+            sides: std::mem::take(&mut sides.nodes),
+            centres: vec![NO_NODE; mesh.elements.len()],
+            edges: std::mem::take(&mut sides.edges),
+            ..Default::default()
+        };
+        let mut next = n + so.edges.len() as u32;
+        for (centre, e) in so.centres.iter_mut().zip(&mesh.elements) {
             if matches!(e, Element::Quad(_)) {
-                centres[i] = next;
+                *centre = next;
                 next += 1;
             }
         }
-        points.resize(points.len() + (next - n) as usize - edges.len(), [0.0; 2]);
-        let mut so = SecondOrder {
-            points,
-            sides,
-            centres,
-            edges,
-            curved: 0,
-            damped: 0,
-            straightened: 0,
-        };
-        // The quads with a curved side are checked; one that fails has its curved sides' middle
-        // nodes moved halfway back to the straight middles (down to a quarter, then straight),
-        // and its neighbours across them are checked again, until none fails. A quad with
-        // straight sides is its bilinear self, valid since its corners are.
+        so.points.resize((next - n) as usize, [0.0; 2]);
+        // 2. The curve points offered to sides only quads hold, off the side's own line.
+        let mut share = vec![0.0; so.edges.len()];
+        let mut offset = vec![[0.0; 2]; so.edges.len()];
+        for &(edge, p) in curved {
+            let Some(k) = so.edge_index(edge) else {
+                continue;
+            };
+            let off = [p[0] - straight[k][0], p[1] - straight[k][1]];
+            let [a, b] = so.edges[k].0.map(|v| mesh.vertices[v as usize]);
+            let along = [b[0] - a[0], b[1] - a[1]];
+            let length = along[0].hypot(along[1]);
+            let across = (off[0] * along[1] - off[1] * along[0]).abs() / length;
+            if sides.quads_only[k]
+                && off.iter().all(|x| x.is_finite())
+                && across > STRAIGHT * length
+            {
+                so.points[k] = p;
+                offset[k] = off;
+                share[k] = 1.0;
+            }
+        }
+        let offered = share.iter().filter(|&&w| w > 0.0).count();
+        // 3. The quads with a curved side are checked; one that fails has its curved sides'
+        // middle nodes moved halfway back to the straight middles (down to a quarter, then
+        // straight), and both quads of each such side are checked again (a half may not be
+        // enough), until none fails. A quad with straight sides is its bilinear self, valid
+        // since its corners are.
         let mut check: Vec<usize> = (0..mesh.elements.len())
             .filter(|&i| so.side_indices(n, i).any(|k| share[k] > 0.0))
             .collect();
@@ -176,17 +140,16 @@ impl SecondOrder {
             for i in failing {
                 let own: Vec<usize> = so.side_indices(n, i).collect();
                 for k in own {
-                    if share[k] > 0.0 {
-                        share[k] = if share[k] > MIN_SHARE {
-                            share[k] / 2.0
-                        } else {
-                            0.0
-                        };
-                        so.points[k] = [0, 1].map(|d| straight[k][d] + share[k] * offset[k][d]);
-                        let others = all[run_start[k]..run_start[k + 1]].iter();
-                        // Both its quads again, this one included: a half may not be enough.
-                        check.extend(others.map(|x| x.1 as usize));
+                    if share[k] == 0.0 {
+                        continue;
                     }
+                    share[k] = if share[k] > MIN_SHARE {
+                        share[k] / 2.0
+                    } else {
+                        0.0
+                    };
+                    so.points[k] = [0, 1].map(|d| straight[k][d] + share[k] * offset[k][d]);
+                    check.extend(sides.elements_of(k));
                 }
             }
         }
@@ -199,11 +162,13 @@ impl SecondOrder {
 
     /// The middle node of the side between vertices `edge` (either way round), if it is one.
     pub fn middle(&self, edge: [u32; 2]) -> Option<u32> {
+        self.edge_index(edge).map(|k| self.edges[k].1)
+    }
+
+    /// The index into [`SecondOrder::edges`] of the side between vertices `edge`.
+    fn edge_index(&self, edge: [u32; 2]) -> Option<usize> {
         let key = [edge[0].min(edge[1]), edge[0].max(edge[1])];
-        self.edges
-            .binary_search_by(|x| x.0.cmp(&key))
-            .ok()
-            .map(|k| self.edges[k].1)
+        self.edges.binary_search_by(|x| x.0.cmp(&key)).ok()
     }
 
     /// The indices into [`SecondOrder::edges`] of element `i`'s sides (`n` vertices).
@@ -244,6 +209,78 @@ impl SecondOrder {
     fn fits(&self, mesh: &SegmentedMeshData, i: usize) -> bool {
         self.quad9(mesh, i)
             .is_none_or(|q| keeps_share_of_straight(&q, CURVED_JACOBIAN_SHARE))
+    }
+}
+
+/// Every element side of a mesh, by edge.
+struct Sides {
+    /// Every side as (edge, element, side number), sorted: an edge's sides are consecutive.
+    all: Vec<([u32; 2], u32, u8)>,
+    /// Per edge, where its sides start in `all` (and the end, last).
+    start: Vec<usize>,
+    /// The edges, sorted, each with its middle node (numbered after the vertices); handed to
+    /// [`SecondOrder::edges`].
+    edges: Vec<([u32; 2], u32)>,
+    /// Per element, the middle node of each side; handed to [`SecondOrder::sides`].
+    nodes: Vec<[u32; 4]>,
+    /// Per edge, whether only quads hold it.
+    quads_only: Vec<bool>,
+}
+
+impl Sides {
+    fn of(mesh: &SegmentedMeshData) -> Self {
+        let n = mesh.vertices.len() as u32;
+        let mut all: Vec<([u32; 2], u32, u8)> = Vec::with_capacity(4 * mesh.elements.len());
+        for (i, e) in mesh.elements.iter().enumerate() {
+            let c = e.corners();
+            for k in 0..c.len() {
+                let (a, b) = (c[k], c[(k + 1) % c.len()]);
+                all.push(([a.min(b), a.max(b)], i as u32, k as u8));
+            }
+        }
+        all.par_sort_unstable();
+        let mut sides = Sides {
+            start: Vec::new(),
+            edges: Vec::new(),
+            nodes: vec![[NO_NODE; 4]; mesh.elements.len()],
+            quads_only: Vec::new(),
+            all: Vec::new(),
+        };
+        let mut at = 0;
+        for run in all.chunk_by(|x, y| x.0 == y.0) {
+            let node = n + sides.edges.len() as u32;
+            sides.edges.push((run[0].0, node));
+            sides.start.push(at);
+            at += run.len();
+            sides.quads_only.push(
+                run.iter()
+                    .all(|&(_, i, _)| matches!(mesh.elements[i as usize], Element::Quad(_))),
+            );
+            for &(_, i, k) in run {
+                sides.nodes[i as usize][k as usize] = node;
+            }
+        }
+        sides.start.push(at);
+        sides.all = all;
+        sides
+    }
+
+    /// Each edge's midpoint.
+    fn straight_middles(&self, mesh: &SegmentedMeshData) -> Vec<[f64; 2]> {
+        self.edges
+            .iter()
+            .map(|&([a, b], _)| {
+                let (p, q) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+                [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]
+            })
+            .collect()
+    }
+
+    /// The elements holding edge `k`.
+    fn elements_of(&self, k: usize) -> impl Iterator<Item = usize> + '_ {
+        self.all[self.start[k]..self.start[k + 1]]
+            .iter()
+            .map(|x| x.1 as usize)
     }
 }
 
