@@ -1,5 +1,5 @@
-//! SVG pictures: elements filled with their label's colour, edges drawn, optionally over the
-//! image. SVG's own frame is y-down like the image, so coordinates are pixels as they are.
+//! SVG pictures: elements filled with their label's colour, edges drawn (a second-order mesh's
+//! bent sides as the curves they are), optionally over the image. SVG's own frame is y-down like the image, so coordinates are pixels as they are.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -54,12 +54,16 @@ pub fn svg_string(mesh: &SegmentedMeshData, options: &SvgOptions) -> String {
         "<g stroke=\"#202020\" stroke-width=\"{}\" stroke-linejoin=\"round\" fill-opacity=\"{}\">",
         options.stroke_width, options.fill_opacity
     );
-    for (e, &l) in mesh.elements.iter().zip(&mesh.labels) {
+    for (i, (e, &l)) in mesh.elements.iter().zip(&mesh.labels).enumerate() {
         let [r, g, b] = mesh
             .label_colours
             .get(l as usize)
             .copied()
             .unwrap_or([128; 3]);
+        if let Some(d) = curved_outline(mesh, i) {
+            let _ = writeln!(s, "<path d=\"{d}\" fill=\"#{r:02x}{g:02x}{b:02x}\"/>");
+            continue;
+        }
         let points: Vec<String> = e
             .corners()
             .iter()
@@ -88,6 +92,35 @@ pub fn svg_string(mesh: &SegmentedMeshData, options: &SvgOptions) -> String {
     }
     let _ = writeln!(s, "</svg>");
     s
+}
+
+/// The outline of element `i` of a second-order mesh as an SVG path, when a side of it is bent:
+/// each bent side the quadratic Bézier through its middle node (control point `2m − (a + b)/2`),
+/// each straight one a line. `None` for an element with straight sides (drawn as a polygon).
+fn curved_outline(mesh: &SegmentedMeshData, i: usize) -> Option<String> {
+    let so = mesh.second_order.as_ref()?;
+    let c = mesh.elements[i].corners();
+    let n = c.len();
+    let mut d = String::new();
+    let mut bent = false;
+    let corner = |k: usize| mesh.vertices[c[k % n] as usize];
+    let _ = write!(d, "M{:.4} {:.4}", corner(0)[0], corner(0)[1]);
+    for k in 0..n {
+        let (a, b, m) = (corner(k), corner(k + 1), mesh.node(so.sides[i][k] as usize));
+        let control = [
+            2.0 * m[0] - 0.5 * (a[0] + b[0]),
+            2.0 * m[1] - 0.5 * (a[1] + b[1]),
+        ];
+        if m != [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])] {
+            bent = true;
+            let _ = write!(d, "Q{:.4} {:.4} ", control[0], control[1]);
+        } else {
+            d.push('L');
+        }
+        let _ = write!(d, "{:.4} {:.4}", b[0], b[1]);
+    }
+    d.push('Z');
+    bent.then_some(d)
 }
 
 /// Writes the SVG picture of `mesh`, atomically.

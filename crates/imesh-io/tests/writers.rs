@@ -654,6 +654,19 @@ fn n_quads(mesh: &SegmentedMeshData) -> usize {
 }
 
 #[test]
+fn svg_draws_a_bent_side_as_the_parabola_through_its_middle_node() {
+    let (mesh, bent) = second_order_quads();
+    let svg = imesh_io::svg_string(&mesh, &imesh_io::SvgOptions::default());
+    // The two quads either side of it are paths; the other four stay polygons.
+    assert_eq!(svg.matches("<polygon ").count(), 4);
+    assert_eq!(svg.matches("<path d=").count(), 2);
+    // The quadratic Bézier from (1, 0) to (1, 1) through (1.2, 0.5) has its control point at
+    // 2 · (1.2, 0.5) − (1, 0.5) = (1.4, 0.5), either way along it.
+    assert_eq!(bent, [1.2, 0.5]);
+    assert_eq!(svg.matches("Q1.4000 0.5000 ").count(), 2);
+}
+
+#[test]
 fn second_order_files_of_every_format_read_back_as_their_corners() {
     let (mesh, _) = second_order_quads();
     let frame = Frame::default();
