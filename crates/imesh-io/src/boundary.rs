@@ -58,11 +58,6 @@ impl Boundary {
         }
         sides
     }
-
-    /// The vertices on the boundary, sorted.
-    pub fn vertices(&self) -> Vec<u32> {
-        edge_vertices(&self.edges)
-    }
 }
 
 /// A side of the domain rectangle `[0, W] × [0, H]`, named as the image shows it: the top is

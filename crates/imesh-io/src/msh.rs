@@ -78,8 +78,8 @@ pub fn msh_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
         members[l as usize][usize::from(matches!(e, Element::Quad(_)))].push(i);
     }
     let mut blocks: Vec<(u32, u32, Vec<usize>)> = Vec::new();
+    let kinds = [false, true].map(|quad| gmsh_type(mesh, quad));
     for &l in used {
-        let kinds = [Element::Triangle([0; 3]), Element::Quad([0; 4])].map(|e| gmsh_type(mesh, &e));
         for (kind, members) in kinds
             .into_iter()
             .zip(std::mem::take(&mut members[l as usize]))
@@ -243,7 +243,8 @@ pub fn msh22_string(mesh: &SegmentedMeshData, frame: &Frame) -> String {
     let _ = writeln!(s, "$Elements\n{}", mesh.elements.len() + lines.len());
     push_lines(&mut s, mesh.elements.len(), |i, s| {
         let (e, l) = (&mesh.elements[i], mesh.labels[i] + 1);
-        let _ = write!(s, "{} {} 2 {l} {l}", i + 1, gmsh_type(mesh, e));
+        let quad = matches!(e, Element::Quad(_));
+        let _ = write!(s, "{} {} 2 {l} {l}", i + 1, gmsh_type(mesh, quad));
         for v in written_nodes(mesh, i, true) {
             let _ = write!(s, " {}", v + 1);
         }
@@ -277,14 +278,14 @@ pub fn write_msh(path: &Path, mesh: &SegmentedMeshData, frame: &Frame) -> Result
     write_atomic(path, msh_string(mesh, frame).as_bytes())
 }
 
-/// Gmsh's element type: 3-node triangle 2, 4-node quad 3; second order, 6-node triangle 9,
-/// 9-node quad 10.
-fn gmsh_type(mesh: &SegmentedMeshData, e: &Element) -> u32 {
-    match (e, mesh.second_order.is_some()) {
-        (Element::Triangle(_), false) => 2,
-        (Element::Quad(_), false) => 3,
-        (Element::Triangle(_), true) => 9,
-        (Element::Quad(_), true) => 10,
+/// Gmsh's type of a triangle or a `quad`: 3-node triangle 2, 4-node quad 3; second order,
+/// 6-node triangle 9, 9-node quad 10.
+fn gmsh_type(mesh: &SegmentedMeshData, quad: bool) -> u32 {
+    match (quad, mesh.second_order.is_some()) {
+        (false, false) => 2,
+        (true, false) => 3,
+        (false, true) => 9,
+        (true, true) => 10,
     }
 }
 

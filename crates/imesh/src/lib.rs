@@ -1850,7 +1850,6 @@ impl MeshOptions {
     }
 }
 
-/// Vertices, elements and labels of a mesh.
 /// The output mesh's vertices, elements and labels, and the points on the boundary curves where
 /// second-order sides put their middle nodes.
 type MeshArrays = (
