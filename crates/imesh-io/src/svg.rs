@@ -1,5 +1,6 @@
 //! SVG pictures: elements filled with their label's colour, edges drawn (a second-order mesh's
-//! bent sides as the curves they are), optionally over the image. SVG's own frame is y-down like the image, so coordinates are pixels as they are.
+//! bent sides as the curves they are), optionally over the image. SVG's own frame is y-down
+//! like the image, so coordinates are pixels as they are.
 
 use std::fmt::Write as _;
 use std::path::Path;
