@@ -225,7 +225,7 @@ pub struct OptimOptions {
     /// shape and scaled Jacobian up to [`REPAIR_JACOBIAN`], so the worst of none of them
     /// falls. The energy of all the quads leaves a quad a third of the mean area, at a tip or
     /// in a strip, where it is: it is one term among thousands. Measured with the defaults,
-    /// quads under 0.25 before → after: see the README's session-35 paragraph.
+    /// quads under 0.25 before → after: see docs/measurements.md's session-35 paragraph.
     pub quality_repair: bool,
 }
 
