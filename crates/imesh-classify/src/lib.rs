@@ -22,6 +22,8 @@
 //! # Ok::<(), imesh_classify::ClassifyError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod cleanup;
 mod error;
 mod grid;

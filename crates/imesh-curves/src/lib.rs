@@ -36,6 +36,8 @@
 //! # Ok::<(), imesh_curves::CurveError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod bezier;
 mod contract;
 mod corners;

@@ -29,6 +29,8 @@
 //! assert!(text.contains("2 1 \"steel\""));
 //! ```
 
+#![warn(missing_docs)]
+
 mod boundary;
 mod histogram;
 mod inp;

@@ -88,7 +88,7 @@ pub const POOR_SCALED_JACOBIAN: f64 = 0.5;
 /// its curved sides and at its corners on G' edges), as many times as the element needs
 /// (tried on the element alone, its inner points relaxed), down to the straight edge, whose
 /// templates are always valid and never poor; neighbouring Steiner vertices of a G' edge keep
-/// shares at most [`SHARE_STEP`] apart, so the damping fades in along the curve. After
+/// shares at most `SHARE_STEP` (a quarter) apart, so the damping fades in along the curve. After
 /// [`LOCAL_ROUNDS`], an element still poor has its G' edges straightened whole. Damping the
 /// pieces near the element rather than the whole G' edge keeps the rest of the curve, and the
 /// turn it was given at a sharp corner: measured against whole-edge halving with the defaults,
@@ -419,7 +419,7 @@ fn blend(ec: &EdgeCurve) -> [Point; 4] {
 
 /// Rounds in which a poor element's pieces are damped where they meet it (its sides' ends and
 /// its corners on G' edges); after them, its G' edges are straightened whole, for at most
-/// [`STRAIGHTENING_ROUNDS`] more: an element whose sides are straight is a straight template,
+/// `STRAIGHTENING_ROUNDS` (ten) more: an element whose sides are straight is a straight template,
 /// never poor. A round halves a piece as many times as its poor elements need, at most five
 /// (then it is straight); later rounds mend what the damping spreading along a curve spoils
 /// in the elements beside it (the fixtures need 1–3 rounds at the default size, 3 px and

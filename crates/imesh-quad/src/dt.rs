@@ -23,8 +23,8 @@ pub struct DensityOptions {
     pub max_size: Option<f64>,
     /// Spacing of a uniform DT', in pixels: boundaries are split into pieces no longer than
     /// this, and the inside away from them is filled with an axis-aligned square lattice of this
-    /// spacing before refinement ([`uniform_points`]), and refinement splits every triangle
-    /// larger than [`MAX_TRIANGLE_AREA`] squared spacings, keeping its points
+    /// spacing before refinement ([`uniform_points`](crate::uniform_points)), and refinement
+    /// splits every triangle larger than [`MAX_TRIANGLE_AREA`] squared spacings, keeping its points
     /// [`BOUNDARY_CLEARANCE`] spacings off the boundaries of their triangles (thin strips stay
     /// whole). `None` leaves DT' graded from the boundary pieces inwards.
     pub spacing: Option<f64>,

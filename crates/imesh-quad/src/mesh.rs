@@ -392,7 +392,9 @@ impl QuadMesh {
         (0..4).all(|i| orient2d(p[(i + 3) % 4], p[i], p[(i + 1) % 4]) > 0.0)
     }
 
-    /// The scaled Jacobian of quad `q` (see [`scaled_jacobian`]).
+    /// The scaled Jacobian of quad `q`: the least sine of its corner angles, signed (Verdict's
+    /// definition for a counter-clockwise quad; negative at a reflex corner), 0 for a quad with a
+    /// zero-length side.
     pub fn scaled_jacobian(&self, q: usize) -> f64 {
         scaled_jacobian(&self.quads[q].map(|v| self.vertices[v as usize]))
     }

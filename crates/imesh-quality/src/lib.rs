@@ -23,6 +23,8 @@
 //! assert_eq!(quad::shape(&clockwise), 1.0);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod curved;
 pub mod quad;
 pub mod tri;

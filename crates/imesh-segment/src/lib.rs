@@ -18,6 +18,8 @@
 //! mesh.triangulation.check().unwrap();
 //! ```
 
+#![warn(missing_docs)]
+
 mod mesh;
 mod partition;
 mod regions;

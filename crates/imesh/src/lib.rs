@@ -17,6 +17,8 @@
 //! assert!(result.report.counts.quads > 0 && result.report.counts.triangles == 0);
 //! ```
 
+#![warn(missing_docs)]
+
 use std::path::Path;
 use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
