@@ -43,7 +43,7 @@ enum Command {
     )]
     Classify(ClassifyArgs),
     /// Measure a mesh file's quality with Verdict's metrics (as VTK computes them): Gmsh MSH 4.1 or
-    /// 2.2, or legacy VTK, ASCII.
+    /// 2.2, legacy VTK or VTK XML (ASCII), or Abaqus .inp.
     #[command(after_help = "Example:\n  imesh quality coins.msh --json")]
     Quality(QualityArgs),
     /// Mesh every image of a folder, in parallel; one failure does not stop the others.
@@ -206,7 +206,7 @@ struct MeshFlags {
 
 #[derive(Args)]
 struct QualityArgs {
-    /// The mesh (.msh or .vtk).
+    /// The mesh (.msh, .vtk, .vtu or .inp).
     mesh: PathBuf,
     /// Print the statistics as JSON instead of a table.
     #[arg(long)]

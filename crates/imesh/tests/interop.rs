@@ -166,6 +166,73 @@ fn meshio_reads_every_format_we_write() {
     }
 }
 
+/// What `imesh quality FILE --json` prints, run in `dir`.
+fn quality_json(dir: &Path, file: &str) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_imesh"))
+        .args(["quality", file, "--json"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "imesh quality {file}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn imesh_quality_reads_what_meshio_writes() {
+    let Ok(python) = std::env::var("IMESH_PYTHON") else {
+        eprintln!("IMESH_PYTHON is not set: skipping the meshio check (.ci/run sets it up)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let image =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
+    for elements in ["quad", "tri"] {
+        let name = format!("{elements}.msh");
+        mesh_with_report(
+            dir.path(),
+            &[
+                "mesh",
+                image.to_str().unwrap(),
+                "-o",
+                &name,
+                "--elements",
+                elements,
+            ],
+        );
+        let ours = quality_json(dir.path(), &name);
+        let written = python_json(&python, "meshio_write.py", &dir.path().join(&name));
+        for format in ["vtu", "inp"] {
+            let file = written[format].as_str().unwrap();
+            let theirs = quality_json(dir.path(), file);
+            for key in ["vertices", "quads", "triangles"] {
+                assert_eq!(theirs[key], ours[key], "{file} {key}");
+            }
+            let block = if elements == "quad" {
+                "quad_quality"
+            } else {
+                "triangle_quality"
+            };
+            for metric in ["shape", "scaled_jacobian", "min_angle_deg"] {
+                for s in ["min", "mean"] {
+                    let (a, b) = (
+                        theirs[block][metric][s].as_f64().unwrap(),
+                        ours[block][metric][s].as_f64().unwrap(),
+                    );
+                    // meshio writes ASCII coordinates to about 12 significant digits.
+                    assert!(
+                        (a - b).abs() <= 1e-6 * b.abs().max(1.0),
+                        "{file} {metric} {s}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn gmsh_opens_our_msh_with_the_same_physical_groups() {
     let Ok(python) = std::env::var("IMESH_PYTHON") else {
