@@ -327,7 +327,7 @@ fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
         if before.is_some_and(char::is_whitespace) {
             if let Some(value) = after.strip_prefix('=') {
                 let value = value.trim_start();
-                let quote = value.chars().next()?;
+                let quote = value.chars().next().filter(|&q| q == '"' || q == '\'')?;
                 let value = &value[1..];
                 return value.find(quote).map(|end| &value[..end]);
             }
@@ -709,6 +709,31 @@ mod tests {
         );
     }
 
+    proptest::proptest! {
+        /// Any text, and any valid file cut or with a character put anywhere, gives a mesh or an
+        /// error: never a panic (`imesh quality` reads whatever a user gives it).
+        #[test]
+        fn no_text_makes_a_reader_panic(
+            text in ".{0,200}", cut in 0usize..2000, at in 0usize..2000, c in proptest::char::any(),
+        ) {
+            let files = [
+                "<VTKFile type=\"UnstructuredGrid\"><Piece><Points><DataArray NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 1 1 0</DataArray></Points><Cells><DataArray Name=\"connectivity\" format=\"ascii\">0 1 2</DataArray><DataArray Name=\"offsets\" format=\"ascii\">3</DataArray><DataArray Name=\"types\" format=\"ascii\">5</DataArray></Cells></Piece></VTKFile>",
+                "*Node\n1, 0, 0\n2, 1, 0\n3, 1, 1\n*Element, type=CPS3, elset=a\n1, 1, 2,\n3\n",
+                "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0\n1 0 0\n1 1 0\n$EndNodes\n$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n",
+                "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0 0 1 0 0 1 1 0\nCELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n5\n",
+            ];
+            for parse in [parse_vtu, parse_inp, parse_msh, parse_vtk] {
+                let _ = parse(&text);
+                for file in files {
+                    let cut = file.char_indices().map(|(i, _)| i).nth(cut % file.chars().count()).unwrap_or(0);
+                    let _ = parse(&file[..cut]);
+                    let at = file.char_indices().map(|(i, _)| i).nth(at % file.chars().count()).unwrap_or(0);
+                    let _ = parse(&format!("{}{c}{}", &file[..at], &file[at..]));
+                }
+            }
+        }
+    }
+
     #[test]
     fn abaqus_area_elements_are_known_by_family_and_node_count() {
         for (kind, want) in [
@@ -736,6 +761,17 @@ mod tests {
         let binary = r#"<VTKFile type="UnstructuredGrid"><Piece><Points><DataArray NumberOfComponents="3" format="binary">AAAA</DataArray></Points><Cells></Cells></Piece></VTKFile>"#;
         let e = parse_vtu(binary).unwrap_err();
         assert!(e.1.contains("only ASCII data arrays"), "{e:?}");
+        // An attribute's value must be quoted; a multi-byte character where the quote should be
+        // is no value (and no panic).
+        assert_eq!(
+            attribute("<DataArray format='ascii'", "format"),
+            Some("ascii")
+        );
+        assert_eq!(attribute("<DataArray format=éasciié", "format"), None);
+        assert_eq!(
+            attribute("<DataArray Xformat=\"a\" format = \"b\"", "format"),
+            Some("b")
+        );
         assert!(parse_vtu("<VTKFile type=\"PolyData\">").is_err());
         let e = parse_vtu(r#"<VTKFile type="UnstructuredGrid"></VTKFile>"#).unwrap_err();
         assert!(e.1.contains("no <Piece>"), "{e:?}");
