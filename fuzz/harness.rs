@@ -441,3 +441,22 @@ pub fn decode(data: &[u8]) {
         );
     }
 }
+
+/// Any text through the mesh readers of `imesh quality` (the first byte picks the format): a
+/// mesh whose every element's corners are among its points, or a clear error.
+pub fn read(data: &[u8]) {
+    let Some((&first, rest)) = data.split_first() else {
+        return;
+    };
+    let format = imesh_io::MeshFormat::ALL[usize::from(first) % imesh_io::MeshFormat::ALL.len()];
+    let text = String::from_utf8_lossy(rest);
+    if let Ok(mesh) = imesh_io::parse_mesh(&text, format) {
+        let n = mesh.vertices.len();
+        for e in &mesh.elements {
+            assert!(
+                e.corners().iter().all(|&v| (v as usize) < n),
+                "{format:?}: an element's corner beyond the {n} points"
+            );
+        }
+    }
+}

@@ -8,7 +8,9 @@ use std::process::Command;
 use std::time::Instant;
 
 /// The harnesses, in the order they run.
-pub const TARGETS: [&str; 5] = ["delaunay", "refine", "simplify", "pipeline", "decode"];
+pub const TARGETS: [&str; 6] = [
+    "delaunay", "refine", "simplify", "pipeline", "decode", "read",
+];
 
 /// Options of `cargo xtask fuzz`.
 pub struct Options {

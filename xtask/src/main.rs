@@ -63,7 +63,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    `fixtures points` or `fixtures quality` for one of them
 
   fuzz             coverage-guided fuzzing (cargo-fuzz, libFuzzer, nightly) of the harnesses
-                   in fuzz/harness.rs: delaunay, refine, simplify, pipeline, decode (all when
+                   in fuzz/harness.rs: delaunay, refine, simplify, pipeline, decode, read (all when
                    none is named), one after the other; inputs that break an invariant land in
                    fuzz/artifacts/TARGET/ (replayed by `cargo test` once under fuzz/regressions/)
     --seconds N    fuzzing time per target (default 600)";

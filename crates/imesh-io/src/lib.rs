@@ -52,7 +52,7 @@ pub use histogram::{histogram_picture, write_histogram, HistogramPanel};
 pub use inp::{inp_string, write_inp};
 pub use msh::{msh22_string, msh_string, write_msh, write_msh22};
 pub use png::{rasterise, write_png};
-pub use read::{read_mesh, ReadError, ReadMesh};
+pub use read::{parse_mesh, read_mesh, MeshFormat, ParseError, ReadError, ReadMesh};
 pub use second_order::{SecondOrder, CURVED_JACOBIAN_SHARE, NO_NODE};
 pub use svg::{svg_string, write_svg, SvgOptions};
 pub use vtk::{vtk_string, write_vtk};

@@ -46,31 +46,92 @@ pub enum ReadError {
     },
 }
 
-/// Reads the mesh at `path` by its extension (`.msh`, `.vtk`, `.vtu` or `.inp`).
+/// The mesh file formats [`read_mesh`] and [`parse_mesh`] read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Gmsh MSH 4.1 or 2.2, ASCII (`.msh`).
+    Msh,
+    /// Legacy VTK unstructured grid, ASCII (`.vtk`).
+    Vtk,
+    /// VTK XML unstructured grid with ASCII data arrays (`.vtu`).
+    Vtu,
+    /// Abaqus input file (`.inp`).
+    Inp,
+}
+
+impl MeshFormat {
+    /// Every format.
+    pub const ALL: [MeshFormat; 4] = [Self::Msh, Self::Vtk, Self::Vtu, Self::Inp];
+
+    /// The format a path's extension names (in any case), if any.
+    ///
+    /// ```
+    /// use imesh_io::MeshFormat;
+    /// assert_eq!(MeshFormat::of_path("out/coins.VTU".as_ref()), Some(MeshFormat::Vtu));
+    /// assert_eq!(MeshFormat::of_path("coins.json".as_ref()), None);
+    /// ```
+    pub fn of_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "msh" => Some(Self::Msh),
+            "vtk" => Some(Self::Vtk),
+            "vtu" => Some(Self::Vtu),
+            "inp" => Some(Self::Inp),
+            _ => None,
+        }
+    }
+}
+
+/// Why a mesh text could not be parsed: the format expected and what is wrong, and where.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("not a valid {format} file: {reason}")]
+pub struct ParseError {
+    /// The format expected (`"Gmsh MSH 4.1"`, `"Abaqus .inp"`, …).
+    pub format: &'static str,
+    /// What is wrong, and where.
+    pub reason: String,
+}
+
+/// Parses a mesh held in memory, in `format`: its 2D points and its triangles and quads (a
+/// second-order element as its corners). Every element's corners index the points.
+///
+/// # Errors
+/// [`ParseError`], saying what is wrong and where.
+///
+/// ```
+/// use imesh_io::{parse_mesh, MeshFormat};
+/// use imesh_quality::Element;
+/// let inp = "*Node\n1, 0, 0\n2, 1, 0\n3, 0, 1\n*Element, type=CPS3\n1, 1, 2, 3\n";
+/// let mesh = parse_mesh(inp, MeshFormat::Inp)?;
+/// assert_eq!(mesh.elements, vec![Element::Triangle([0, 1, 2])]);
+/// assert!(parse_mesh("*Node\n1, 0\n", MeshFormat::Inp).is_err());
+/// # Ok::<(), imesh_io::ParseError>(())
+/// ```
+pub fn parse_mesh(text: &str, format: MeshFormat) -> Result<ReadMesh, ParseError> {
+    let parse = match format {
+        MeshFormat::Msh => parse_msh,
+        MeshFormat::Vtk => parse_vtk,
+        MeshFormat::Vtu => parse_vtu,
+        MeshFormat::Inp => parse_inp,
+    };
+    parse(text).map_err(|(format, reason)| ParseError { format, reason })
+}
+
+/// Reads the mesh at `path` by its extension (`.msh`, `.vtk`, `.vtu` or `.inp`; [`parse_mesh`]).
 ///
 /// # Errors
 /// [`ReadError`], saying what is wrong.
 pub fn read_mesh(path: &Path) -> Result<ReadMesh, ReadError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let parse = match ext.as_deref() {
-        Some("msh") => parse_msh,
-        Some("vtk") => parse_vtk,
-        Some("vtu") => parse_vtu,
-        Some("inp") => parse_inp,
-        _ => {
-            return Err(ReadError::Unsupported {
-                path: path.to_path_buf(),
-            })
-        }
+    let Some(format) = MeshFormat::of_path(path) else {
+        return Err(ReadError::Unsupported {
+            path: path.to_path_buf(),
+        });
     };
     let text = std::fs::read_to_string(path).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(&text).map_err(|(format, reason)| ReadError::Format {
+    parse_mesh(&text, format).map_err(|ParseError { format, reason }| ReadError::Format {
         path: path.to_path_buf(),
         format,
         reason,

@@ -54,6 +54,11 @@ fn decode_regressions() {
     replay("decode", harness::decode);
 }
 
+#[test]
+fn read_regressions() {
+    replay("read", harness::read);
+}
+
 /// The harnesses on a few fixed inputs of every kind: they accept them (a harness that panics on
 /// valid input would make the fuzzers useless) and reject nothing silently.
 #[test]
@@ -74,4 +79,16 @@ fn harnesses_accept_ordinary_inputs() {
     .unwrap();
     harness::decode(&png);
     harness::decode(b"GIF89a not really");
+    // A valid file of every format the readers take, and the same bytes as the others.
+    let files: [&[u8]; 4] = [
+        b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n$Elements\n1\n1 2 0 1 2 3\n$EndElements\n",
+        b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0 0 1 0 0 0 1 0\nCELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n5\n",
+        br#"<VTKFile type="UnstructuredGrid"><Piece><Points><DataArray NumberOfComponents="3" format="ascii">0 0 0 1 0 0 0 1 0</DataArray></Points><Cells><DataArray Name="connectivity" format="ascii">0 1 2</DataArray><DataArray Name="offsets" format="ascii">3</DataArray><DataArray Name="types" format="ascii">5</DataArray></Cells></Piece></VTKFile>"#,
+        b"*Node\n1, 0, 0\n2, 1, 0\n3, 0, 1\n*Element, type=CPS3\n1, 1, 2, 3\n",
+    ];
+    for format in 0..4u8 {
+        for file in files {
+            harness::read(&[&[format][..], file].concat());
+        }
+    }
 }
