@@ -1,37 +1,14 @@
 //! The `imesh` program end to end on fixtures: outputs, exit codes, error messages, no half files.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Command;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/images")
-        .join(name)
-}
+mod support;
 
-fn imesh(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_imesh"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the imesh binary runs")
-}
-
-/// [`imesh`], which must succeed (its stderr shown if not).
-fn imesh_ok(args: &[&str], dir: &Path) -> Output {
-    let out = imesh(args, dir);
-    assert!(
-        out.status.success(),
-        "imesh {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-/// The JSON report `r.json` a run wrote in `dir`.
-fn read_report(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap()
-}
+use support::fixture;
+use support::program::{
+    assert_same_statistics, imesh, imesh_ok, quality_block, quality_json, read_report,
+};
 
 /// The counts of an MSH 4.1 file: nodes, surface elements, physical surfaces, physical curves.
 fn msh_counts(text: &str) -> (usize, usize, usize, usize) {
@@ -786,8 +763,7 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
         }
         imesh_ok(&args, dir.path());
         let report: serde_json::Value = read_report(dir.path());
-        let out = imesh_ok(&["quality", name, "--json"], dir.path());
-        let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let measured = quality_json(dir.path(), name);
         // Abaqus has no 9-node plane quad: a second-order `.inp` leaves the centres out.
         let centres = if name.ends_with(".inp") && order == "2" {
             report["counts"]["quads"].as_u64().unwrap()
@@ -813,24 +789,13 @@ fn quality_measures_a_written_mesh_as_the_report_did() {
             measured["triangles"], report["counts"]["triangles"],
             "{name}"
         );
-        let block = if elements == "quad" {
-            "quad_quality"
-        } else {
-            "triangle_quality"
-        };
         // The written frame is y-up: the same shapes, so the same statistics (to rounding).
-        for metric in ["shape", "scaled_jacobian", "min_angle_deg"] {
-            for s in ["min", "mean"] {
-                let (a, b) = (
-                    measured[block][metric][s].as_f64().unwrap(),
-                    report["quality"][metric][s].as_f64().unwrap(),
-                );
-                assert!(
-                    (a - b).abs() <= 1e-9 * b.abs().max(1.0),
-                    "{name} {metric} {s}: {a} vs {b}"
-                );
-            }
-        }
+        assert_same_statistics(
+            &measured[quality_block(elements)],
+            &report["quality"],
+            1e-9,
+            name,
+        );
         let table = imesh(&["quality", name], dir.path());
         assert!(String::from_utf8_lossy(&table.stdout).contains("scaled Jacobian"));
     }

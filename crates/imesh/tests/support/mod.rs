@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 
 use image::{DynamicImage, GrayImage, ImageBuffer, Luma, LumaA, Rgba};
 
+pub mod program;
+
 /// A grey image from a function of the pixel.
 pub fn grey(w: u32, h: u32, f: impl Fn(u32, u32) -> u8) -> DynamicImage {
     DynamicImage::ImageLuma8(GrayImage::from_fn(w, h, |x, y| Luma([f(x, y)])))
