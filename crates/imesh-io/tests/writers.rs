@@ -760,31 +760,15 @@ fn second_order_files_of_every_format_read_back_as_their_corners() {
         let read = read_mesh(&path).unwrap();
         assert_eq!(read.vertices.len(), written_nodes(&path), "{path:?}");
         // The same corner polygons (MSH 4.1 lists the elements by label).
-        let polygons =
-            |vertices: &[[f64; 2]], elements: &[Element], map: &dyn Fn([f64; 2]) -> [f64; 2]| {
-                let mut all: Vec<String> = elements
-                    .iter()
-                    .map(|e| {
-                        format!(
-                            "{:?}",
-                            e.corners()
-                                .iter()
-                                .map(|&v| map(vertices[v as usize]))
-                                .collect::<Vec<_>>()
-                        )
-                    })
-                    .collect();
-                all.sort();
-                all
-            };
         let written: Vec<Element> = mesh
             .elements
             .iter()
             .map(|e| Element::Quad(written_corners(e).try_into().unwrap()))
             .collect();
+        let mapped: Vec<[f64; 2]> = mesh.vertices.iter().map(|&p| frame.map(&mesh, p)).collect();
         assert_eq!(
-            polygons(&read.vertices, &read.elements, &|p| p),
-            polygons(&mesh.vertices, &written, &|p| frame.map(&mesh, p)),
+            corner_polygons(&read.vertices, &read.elements),
+            corner_polygons(&mapped, &written),
             "{path:?}"
         );
     }
