@@ -63,9 +63,7 @@ fn meshio_reads_every_format_we_write() {
         ("stardist-mask2d_labels.png", 512.0, 512.0),
     ];
     for (fixture, width, height) in fixtures {
-        let image = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/images")
-            .join(fixture);
+        let image = support::fixture(fixture);
         for (name, pixel, version) in [
             ("m.msh", "1", "4.1"),
             ("m22.msh", "1", "2.2"),
@@ -169,8 +167,7 @@ fn imesh_quality_reads_what_meshio_writes() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let image =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
+    let image = support::fixture("skimage-coins.png");
     for elements in ["quad", "tri"] {
         let name = format!("{elements}.msh");
         mesh_with_report(
@@ -213,9 +210,7 @@ fn gmsh_opens_our_msh_with_the_same_physical_groups() {
     ] {
         let fixture_name = fixture;
         let fixture = format!("{fixture_name} (MSH {version})");
-        let image = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/images")
-            .join(fixture_name);
+        let image = support::fixture(fixture_name);
         let args = ["mesh", image.to_str().unwrap(), "-o", "m.msh"];
         let report = mesh_with_report(
             dir.path(),
@@ -298,8 +293,7 @@ fn second_order_files_open_as_valid_curved_quads() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let image =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/images/skimage-coins.png");
+    let image = support::fixture("skimage-coins.png");
     for (name, version) in [("q.msh", "4.1"), ("q22.msh", "2.2"), ("q.vtu", "")] {
         let mut args = vec!["mesh", image.to_str().unwrap(), "--order", "2", "-o", name];
         if !version.is_empty() {
