@@ -58,6 +58,18 @@ fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
 }
 
+/// Every fixture image (`fixtures/images/*.png`), in name order.
+pub fn fixture_images() -> Result<Vec<PathBuf>, String> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(fixtures_dir())
+        .map_err(|e| format!("fixtures/images: {e}"))?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    paths.sort();
+    Ok(paths)
+}
+
 /// Runs the pipeline on `image`, recording the heap peak of each stage, then writes the mesh
 /// as MSH 4.1 (timed: the paper's "write" column).
 fn measure(name: &str, image: &image::DynamicImage, options: &MeshOptions) -> Result<Row, String> {
@@ -264,13 +276,7 @@ pub fn run(scaling_max: u32, readme: bool) -> Result<(), String> {
         markdown.push_str(&text);
     };
 
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(fixtures_dir())
-        .map_err(|e| format!("fixtures/images: {e}"))?
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "png"))
-        .collect();
-    paths.sort();
+    let paths = fixture_images()?;
     let (mut fixtures, mut graded_fixtures, mut uniform_fixtures) =
         (Vec::new(), Vec::new(), Vec::new());
     let graded = MeshOptions {

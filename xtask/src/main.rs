@@ -5,7 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-//! cargo xtask compare gmsh [--size auto|graded|PX]
+//! cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
 //! ```
@@ -25,7 +25,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-       cargo xtask compare gmsh [--size auto|graded|PX]
+       cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
 
@@ -55,7 +55,9 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    same simplified boundaries of five fixtures at about the same quad count,
                    both measured with our metrics; Gmsh from PyPI into target/venv-gmsh;
                    writes target/bench/compare-gmsh.json
-    --size S             our element size (auto, graded or pixels; default: graded)
+    --size S             our element size (auto, graded or pixels; default: auto)
+    --fixtures F         all (every fixture), default (the five), or file names under
+                         fixtures/images separated by commas
 
   fixtures         regenerate everything under fixtures/ that this project derives, and say
                    what changed: points/disc-boundary.txt (a synthetic label boundary) and
@@ -128,15 +130,18 @@ fn run(args: &[String]) -> Result<(), String> {
             bench_pipeline::run(side, readme)
         }
         ["compare", "gmsh", rest @ ..] => {
-            let options = match rest {
-                [] => imesh::MeshOptions::default(),
-                ["--size", size] => imesh::MeshOptions {
-                    size: size.parse()?,
-                    ..imesh::MeshOptions::default()
-                },
-                _ => return Err(format!("unknown options '{}'", rest.join(" "))),
-            };
-            compare_gmsh::run(options)
+            let mut options = imesh::MeshOptions::default();
+            let mut fixtures = compare_gmsh::Fixtures::Default;
+            let mut rest = rest;
+            loop {
+                match rest {
+                    [] => break,
+                    ["--size", size, more @ ..] => (options.size, rest) = (size.parse()?, more),
+                    ["--fixtures", list, more @ ..] => (fixtures, rest) = (list.parse()?, more),
+                    _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+                }
+            }
+            compare_gmsh::run(options, &fixtures)
         }
         ["fixtures", "quality"] => fixtures::quality(),
         ["fixtures", "points"] => fixtures::points(),
