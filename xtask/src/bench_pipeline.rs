@@ -54,7 +54,8 @@ fn load(path: &Path) -> Result<image::DynamicImage, String> {
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn fixtures_dir() -> PathBuf {
+/// `fixtures/images`.
+pub fn fixtures_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
 }
 

@@ -65,8 +65,8 @@ impl std::str::FromStr for Fixtures {
 
 impl Fixtures {
     /// The image files, each checked to exist.
-    fn paths(&self, root: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
-        let dir = root.join("fixtures/images");
+    fn paths(&self) -> Result<Vec<std::path::PathBuf>, String> {
+        let dir = crate::bench_pipeline::fixtures_dir();
         let named = |names: &mut dyn Iterator<Item = &str>| {
             names
                 .map(|name| {
@@ -243,7 +243,7 @@ fn cell(s: &Option<Side>, ours: &Side) -> String {
 /// size giving about our quad count) and writes `target/bench/compare-gmsh.json`.
 pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
     let root = crate::fixtures::workspace_root()?;
-    let paths = fixtures.paths(&root)?;
+    let paths = fixtures.paths()?;
     let python = crate::fixtures::venv_python(&root, "venv-gmsh", "import gmsh", GMSH)?;
     let mut rows = Vec::new();
     println!("| fixture | ours: quads | S&S worst / mean | SJ worst / mean | s | Blossom: quads | S&S | SJ | meshing s (ours/Gmsh) | geometry + meshing s (ours/Gmsh) | quasi-structured: quads | S&S | SJ | meshing s (ours/Gmsh) | geometry + meshing s (ours/Gmsh) |");
@@ -377,4 +377,38 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
     std::fs::write(&out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     println!("\nwritten {}", out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--fixtures` takes all, default or names; the names must be fixtures, and all is every
+    /// image under fixtures/images, the default five among them.
+    #[test]
+    fn the_fixtures_are_chosen_by_name_or_all() {
+        assert_eq!("all".parse(), Ok(Fixtures::All));
+        assert_eq!("default".parse(), Ok(Fixtures::Default));
+        assert_eq!(
+            "skimage-coins.png, skimage-grass.png".parse(),
+            Ok(Fixtures::Named(vec![
+                "skimage-coins.png".into(),
+                "skimage-grass.png".into()
+            ]))
+        );
+        assert!(" , ".parse::<Fixtures>().is_err());
+
+        let all = Fixtures::All.paths().unwrap();
+        let default = Fixtures::Default.paths().unwrap();
+        assert_eq!(default.len(), DEFAULT_FIXTURES.len());
+        assert!(default.iter().all(|p| all.contains(p)));
+        assert!(all.len() > default.len());
+        let named = Fixtures::Named(vec!["skimage-coins.png".into()]);
+        assert_eq!(
+            named.paths().unwrap(),
+            [crate::bench_pipeline::fixtures_dir().join("skimage-coins.png")]
+        );
+        let missing = Fixtures::Named(vec!["no-such.png".into()]);
+        assert!(missing.paths().unwrap_err().contains("no-such.png"));
+    }
 }

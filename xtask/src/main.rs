@@ -52,9 +52,10 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
     --readme             also write the tables into README.md's results section
 
   compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
-                   same simplified boundaries of five fixtures at about the same quad count,
-                   both measured with our metrics; Gmsh from PyPI into target/venv-gmsh;
-                   writes target/bench/compare-gmsh.json
+                   same simplified boundaries of the fixtures (five label-like ones unless
+                   --fixtures) at about the same quad count, both measured with our metrics,
+                   Gmsh's time with and without building its geometry; Gmsh from PyPI into
+                   target/venv-gmsh; writes target/bench/compare-gmsh.json
     --size S             our element size (auto, graded or pixels; default: auto)
     --fixtures F         all (every fixture), default (the five), or file names under
                          fixtures/images separated by commas
