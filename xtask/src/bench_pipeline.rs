@@ -12,6 +12,7 @@ use imesh_quality::QuadHistograms;
 use serde::Serialize;
 
 use crate::alloc;
+use crate::fixtures::{fixture_images, fixtures_dir};
 
 /// One run: counts, seconds per stage, peak heap per stage, quality.
 #[derive(Serialize)]
@@ -52,23 +53,6 @@ struct Seconds {
 fn load(path: &Path) -> Result<image::DynamicImage, String> {
     imesh_classify::load_image(path, imesh_classify::DEFAULT_MAX_PIXELS)
         .map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// `fixtures/images`.
-pub fn fixtures_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
-}
-
-/// Every fixture image (`fixtures/images/*.png`), in name order.
-pub fn fixture_images() -> Result<Vec<PathBuf>, String> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(fixtures_dir())
-        .map_err(|e| format!("fixtures/images: {e}"))?
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "png"))
-        .collect();
-    paths.sort();
-    Ok(paths)
 }
 
 /// Runs the pipeline on `image`, recording the heap peak of each stage, then writes the mesh

@@ -66,7 +66,7 @@ impl std::str::FromStr for Fixtures {
 impl Fixtures {
     /// The image files, each checked to exist.
     fn paths(&self) -> Result<Vec<std::path::PathBuf>, String> {
-        let dir = crate::bench_pipeline::fixtures_dir();
+        let dir = crate::fixtures::fixtures_dir();
         let named = |names: &mut dyn Iterator<Item = &str>| {
             names
                 .map(|name| {
@@ -83,7 +83,7 @@ impl Fixtures {
         };
         match self {
             Self::Default => named(&mut DEFAULT_FIXTURES.iter().copied()),
-            Self::All => crate::bench_pipeline::fixture_images(),
+            Self::All => crate::fixtures::fixture_images(),
             Self::Named(names) => named(&mut names.iter().map(String::as_str)),
         }
     }
@@ -144,7 +144,8 @@ fn side(
     vertices: &[[f64; 2]],
     quads: &[[u32; 4]],
     triangles: usize,
-    [seconds, geometry_seconds]: [f64; 2],
+    seconds: f64,
+    geometry_seconds: f64,
 ) -> Side {
     let q = QuadQuality::of(vertices, quads);
     Side {
@@ -291,12 +292,7 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
                 imesh_quality::Element::Triangle(_) => None,
             })
             .collect();
-        let our_side = side(
-            &our_vertices,
-            &our_quads,
-            0,
-            [ours.report.seconds.total, 0.0],
-        );
+        let our_side = side(&our_vertices, &our_quads, 0, ours.report.seconds.total, 0.0);
         let target = our_quads.len() as f64;
         let peer = |algorithm: &str| -> Option<Side> {
             // Quads of side lc: about area / lc² (the subdivision splits every element of the
@@ -339,7 +335,8 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
                     &m.nodes,
                     &m.quads,
                     m.triangles.len(),
-                    [m.seconds, m.geometry_seconds],
+                    m.seconds,
+                    m.geometry_seconds,
                 )
             })
         };
@@ -406,7 +403,7 @@ mod tests {
         let named = Fixtures::Named(vec!["skimage-coins.png".into()]);
         assert_eq!(
             named.paths().unwrap(),
-            [crate::bench_pipeline::fixtures_dir().join("skimage-coins.png")]
+            [crate::fixtures::fixtures_dir().join("skimage-coins.png")]
         );
         let missing = Fixtures::Named(vec!["no-such.png".into()]);
         assert!(missing.paths().unwrap_err().contains("no-such.png"));

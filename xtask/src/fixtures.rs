@@ -18,6 +18,23 @@ pub fn workspace_root() -> Result<PathBuf, String> {
         .ok_or_else(|| "xtask is not inside the workspace".to_string())
 }
 
+/// `fixtures/images`.
+pub fn fixtures_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures/images")
+}
+
+/// Every fixture image (`fixtures/images/*.png`), in name order.
+pub fn fixture_images() -> Result<Vec<PathBuf>, String> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(fixtures_dir())
+        .map_err(|e| format!("fixtures/images: {e}"))?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    paths.sort();
+    Ok(paths)
+}
+
 fn run(cmd: &mut Command, what: &str) -> Result<(), String> {
     let status = cmd
         .status()

@@ -170,8 +170,8 @@ pub const SHARP_LENGTH: f64 = 1.0;
 /// chords next to them, which can bring another chord near a vertex: the rounds go on until
 /// none is left. Measured with no options: grass needs three, aloe six (each other fixture at
 /// most two, the earlier bound); with two, aloe kept a chord 0.02 px from another
-/// boundary's vertex, which refinement filled with quads down to 0.01 px (shape-and-size worst
-/// 4e-10 → 5e-5, Gmsh's 3e-5 on the same boundaries; grass's worst shape 0.406 → 0.422).
+/// boundary's vertex, which refinement filled with quads down to 0.01 px (worst shape-and-size
+/// 4e-10 → 5e-5; grass's worst shape 0.406 → 0.422).
 pub const NECK_ROUNDS: usize = 8;
 
 /// Most rounds of merging the regions that simplification flattened below the minimum width,
@@ -2513,7 +2513,7 @@ mod tests {
         let (c, _) = pipeline
             .curves_wide_enough(t, &mut label, w, h, Some(q), min_width)
             .unwrap();
-        // The pins of the first two rounds (21, and 75 at sharp sectors) and of the third.
+        // Two rounds pin 21 neck vertices (and 75 at sharp sectors); the third pins more.
         assert!(c.necks > 21, "grass needs a third round: {} necks", c.necks);
         assert!(neck_vertices(&c.g, &c.simplified, NECK_SHARE * q).is_empty());
         assert!(c.simplified.max_deviation <= pipeline.tolerance());
