@@ -41,9 +41,7 @@ pub fn run(global_iterations: u64) -> Result<(), String> {
     println!("| fixture | method | quads | S&S worst / mean | shape worst / mean | SJ worst / mean | energy | sweeps | optimise s |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for (file, small) in FIXTURES {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../fixtures/images")
-            .join(file);
+        let path = crate::fixtures::fixtures_dir().join(file);
         let mut methods = vec![
             OptimizerMethod::None,
             OptimizerMethod::Laplacian,

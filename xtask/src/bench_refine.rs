@@ -41,9 +41,7 @@ struct Peers<T> {
 /// The boundaries between labels of a label image, plus the image border, as maximal straight runs
 /// of pixel edges between pixel corners.
 fn label_boundaries(file: &str) -> Result<Pslg, String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fixtures/images")
-        .join(file);
+    let path = crate::fixtures::fixtures_dir().join(file);
     let img = load_image(&path, DEFAULT_MAX_PIXELS).map_err(|e| e.to_string())?;
     let grid = label_map(&img, 4096).map_err(|e| e.to_string())?;
     let (w, h) = (grid.width(), grid.height());
