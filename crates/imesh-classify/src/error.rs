@@ -15,7 +15,7 @@ pub enum ClassifyError {
     },
     /// The file is not an image the decoder understands, or it is damaged.
     #[error(
-        "cannot decode '{path}' as an image: {reason} (give a PNG, JPEG, TIFF, BMP or PNM file)"
+        "cannot decode '{path}' as an image: {reason} (give a PNG, JPEG, BMP or PNM file, or a TIFF of 8- or 16-bit channels or of one grey channel of any type)"
     )]
     Decode {
         /// The file.

@@ -77,8 +77,10 @@ fn seed_centres(points: &[[f32; 3]], weights: &[f64], k: usize) -> Vec<[f32; 3]>
 
 /// Clusters the image's colours into `k` clusters (fewer when it has fewer distinct colours).
 /// Labels are ordered by the clusters' lightness; each label's colour is its cluster's mean colour.
+/// An image deeper than 8 bits is clustered in its values stretched over 0–255
+/// ([`crate::eight_bit`]).
 pub fn kmeans(image: &DynamicImage, k: usize) -> LabelGrid {
-    let rgb = image.to_rgb8();
+    let rgb = crate::eight_bit(image).to_rgb8();
     let keys: Vec<u32> = rgb
         .as_raw()
         .par_chunks_exact(3)

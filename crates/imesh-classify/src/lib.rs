@@ -25,7 +25,9 @@
 #![warn(missing_docs)]
 
 mod cleanup;
+mod depth;
 mod error;
+mod grey_tiff;
 mod grid;
 mod kmeans;
 mod labels;
@@ -38,6 +40,7 @@ mod threshold;
 use image::DynamicImage;
 
 pub use cleanup::{majority_filter, pixel_regions, remove_small_regions, PixelRegion};
+pub use depth::eight_bit;
 pub use error::ClassifyError;
 pub use grid::{LabelGrid, Region};
 pub use kmeans::kmeans;

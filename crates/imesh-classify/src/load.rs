@@ -5,13 +5,17 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageFormat, ImageReader, Limits};
 
+use crate::grey_tiff::{decode_grey_tiff, is_tiff};
 use crate::ClassifyError;
 
 /// Default pixel limit: 2^28 (a 16384 × 16384 image).
 pub const DEFAULT_MAX_PIXELS: u64 = 1 << 28;
 
 /// Loads any image the `image` crate decodes (PNG, JPEG, TIFF, BMP, PNM; 8 or 16 bits; grey,
-/// grey + alpha, RGB, RGBA), refusing images over `max_pixels` before decoding them.
+/// grey + alpha, RGB, RGBA), and grey TIFFs of any sample type (signed, 32- or 64-bit integers,
+/// floating point: brought to 16-bit grey, whole values from 0 to 65 535 kept as they are,
+/// others stretched over the 16 bits in their order), refusing images over `max_pixels`
+/// before decoding them.
 ///
 /// # Errors
 /// [`ClassifyError::Io`] (missing file), [`ClassifyError::Decode`] (not an image, truncated),
@@ -74,19 +78,33 @@ fn decode(bytes: &[u8], path: &Path, max_pixels: u64) -> Result<DynamicImage, Cl
                 r
             })
     };
-    let (width, height) = reader().map_err(io)?.into_dimensions().map_err(decode)?;
-    check_size(path, width, height, max_pixels)?;
-    let mut reader = reader().map_err(io)?;
-    let mut limits = Limits::default();
-    // 16 bytes per pixel covers RGBA at 32-bit float, the widest layout decoded here.
-    limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 20));
-    reader.limits(limits);
-    let image = reader.decode().map_err(decode)?;
+    let with_image = || {
+        let (width, height) = reader().map_err(io)?.into_dimensions().map_err(decode)?;
+        check_size(path, width, height, max_pixels)?;
+        let mut reader = reader().map_err(io)?;
+        let mut limits = Limits::default();
+        // 16 bytes per pixel covers RGBA at 32-bit float, the widest layout decoded here.
+        limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 20));
+        reader.limits(limits);
+        reader.decode().map_err(decode)
+    };
+    let image = match with_image() {
+        // The grey TIFFs the `image` crate leaves out (signed, 32- or 64-bit, floating point).
+        Err(e @ ClassifyError::Decode { .. }) if is_tiff(bytes) => {
+            decode_grey_tiff(bytes, path, max_pixels).unwrap_or(Err(e))?
+        }
+        other => other?,
+    };
     check_size(path, image.width(), image.height(), max_pixels)?;
     Ok(image)
 }
 
-fn check_size(path: &Path, width: u32, height: u32, max_pixels: u64) -> Result<(), ClassifyError> {
+pub(crate) fn check_size(
+    path: &Path,
+    width: u32,
+    height: u32,
+    max_pixels: u64,
+) -> Result<(), ClassifyError> {
     let pixels = u64::from(width) * u64::from(height);
     if pixels == 0 {
         return Err(ClassifyError::EmptyImage {

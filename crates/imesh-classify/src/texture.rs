@@ -206,7 +206,8 @@ struct Planes {
 
 impl Planes {
     fn of(image: &DynamicImage, half: i32) -> Self {
-        let rgb = image.to_rgb8();
+        // A deep image's own stretch over 8 bits: training and classifying one image agree.
+        let rgb = crate::eight_bit(image).to_rgb8();
         let mut data: Vec<[u8; CHANNELS]> = rgb
             .as_raw()
             .par_chunks_exact(3)

@@ -6,9 +6,11 @@ use rayon::prelude::*;
 use crate::grid::{palette_colour, Region};
 use crate::LabelGrid;
 
-/// The 8-bit luminance of the image (Rec. 709 weights, as the `image` crate computes it).
+/// The 8-bit luminance of the image (Rec. 709 weights, as the `image` crate computes it); of an
+/// image deeper than 8 bits, of its values stretched over 0–255 ([`crate::eight_bit`]), so that
+/// explicit levels (`threshold:T1,T2`) are then levels of that stretch.
 pub fn luminance(image: &DynamicImage) -> GrayImage {
-    image.to_luma8()
+    crate::eight_bit(image).to_luma8()
 }
 
 /// Labels by luminance level: `v ≤ levels[0]` → 0, `levels[0] < v ≤ levels[1]` → 1, … (levels

@@ -200,6 +200,124 @@ fn deep_and_alpha_images_load_and_label() {
     );
 }
 
+/// A grey TIFF of `width` × `height` samples of colour type `C`, written by the `tiff` crate.
+fn grey_tiff<C: tiff::encoder::colortype::ColorType>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    samples: &[C::Inner],
+) where
+    [C::Inner]: tiff::encoder::TiffValue,
+{
+    let file = std::fs::File::create(path).unwrap();
+    tiff::encoder::TiffEncoder::new(file)
+        .unwrap()
+        .write_image::<C>(width, height, samples)
+        .unwrap();
+}
+
+#[test]
+fn grey_tiffs_of_every_sample_type_load() {
+    use tiff::encoder::colortype::{Gray32, Gray32Float, Gray64Float, GrayI16, GrayI32};
+    let scratch = temp_dir();
+    let dir = scratch.path();
+    // The `image` crate decodes none of these five.
+    // A 32-bit label map: its ids are its region names.
+    let ids: Vec<u32> = (0..200).map(|i| [0, 7, 4000][i % 20 / 7]).collect();
+    let p = dir.join("labels-u32.tif");
+    grey_tiff::<Gray32>(&p, 20, 10, &ids);
+    let grid = label_map(&load_image(&p, DEFAULT_MAX_PIXELS).unwrap(), 256).unwrap();
+    let names: Vec<&str> = grid.regions().iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["value 0", "value 7", "value 4000"]);
+    assert_eq!((grid.label(0, 0), grid.label(19, 9)), (0, 2));
+    // Ids over 16 bits stay apart, in their order.
+    let wide: Vec<i32> = (0..200)
+        .map(|i| [-5, 1, 2, 900_000_000][i % 20 / 5])
+        .collect();
+    let p = dir.join("labels-i32.tif");
+    grey_tiff::<GrayI32>(&p, 20, 10, &wide);
+    let grid = label_map(&load_image(&p, DEFAULT_MAX_PIXELS).unwrap(), 256).unwrap();
+    assert_eq!(grid.num_labels(), 4);
+    assert!((0..4).all(|k| grid.label(5 * k, 3) == k));
+    // A CT slice in Hounsfield units (air −1 000, a disc of bone 1 500): Otsu finds the disc.
+    let ct: Vec<i16> = (0..1600)
+        .map(|i| {
+            let (x, y) = (i % 40 - 20, i / 40 - 20);
+            if x * x + y * y < 100 {
+                1500 + (i % 7) as i16
+            } else {
+                -1000 + (i % 5) as i16
+            }
+        })
+        .collect();
+    let p = dir.join("ct-i16.tif");
+    grey_tiff::<GrayI16>(&p, 40, 40, &ct);
+    let img = load_image(&p, DEFAULT_MAX_PIXELS).unwrap();
+    assert!(matches!(img, DynamicImage::ImageLuma16(_)));
+    let grid = classify(&img, &"otsu".parse().unwrap(), &ClassifyOptions::default()).unwrap();
+    assert_eq!((grid.label(20, 20), grid.label(0, 0)), (1, 0));
+    // Floating point, with a not-a-number hole: the hole takes the lowest level.
+    let mut field: Vec<f32> = (0..1600).map(|i| (i % 40) as f32 * 0.01).collect();
+    field[0] = f32::NAN;
+    let p = dir.join("field-f32.tif");
+    grey_tiff::<Gray32Float>(&p, 40, 40, &field);
+    let DynamicImage::ImageLuma16(grey) = load_image(&p, DEFAULT_MAX_PIXELS).unwrap() else {
+        panic!("a float TIFF loads as 16-bit grey");
+    };
+    assert_eq!(
+        (grey[(0, 0)][0], grey[(0, 1)][0], grey[(39, 0)][0]),
+        (0, 0, 65535)
+    );
+    assert!((1..40).all(|x| grey[(x - 1, 1)][0] < grey[(x, 1)][0]));
+    let p = dir.join("field-f64.tif");
+    let field: Vec<f64> = field.iter().map(|&v| f64::from(v)).collect();
+    grey_tiff::<Gray64Float>(&p, 40, 40, &field);
+    assert_eq!(
+        load_image(&p, DEFAULT_MAX_PIXELS).unwrap().to_luma16(),
+        grey
+    );
+    // The pixel limit holds before decoding.
+    let e = load_image(&p, 1000).unwrap_err();
+    assert!(
+        matches!(e, ClassifyError::TooLarge { pixels: 1600, .. }),
+        "{e}"
+    );
+    // A TIFF neither decoder reads (cut short) is still a clear error.
+    let bytes = std::fs::read(&p).unwrap();
+    let cut = dir.join("cut.tif");
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+    let e = load_image(&cut, DEFAULT_MAX_PIXELS).unwrap_err();
+    assert!(matches!(e, ClassifyError::Decode { .. }), "{e}");
+}
+
+#[test]
+fn a_deep_image_using_few_of_its_levels_is_classified_on_its_own_range() {
+    // A 12-bit camera's micrograph in a 16-bit file: background 1 000, a disc 120 brighter,
+    // noise of ±40 (on 8 bits, /257, nearly every pixel falls on level 4).
+    let noise = |x: u32, y: u32| ((x * 7919 + y * 104_729) % 81) as u16;
+    let inside = |x: u32, y: u32| (x as i32 - 40).pow(2) + (y as i32 - 30).pow(2) < 400;
+    let img: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_fn(80, 60, |x, y| {
+        Luma([960 + noise(x, y) + if inside(x, y) { 120 } else { 0 }])
+    });
+    let img = DynamicImage::ImageLuma16(img);
+    for classifier in ["auto", "otsu", "kmeans:2"] {
+        let grid = classify(
+            &img,
+            &classifier.parse().unwrap(),
+            &ClassifyOptions::default(),
+        )
+        .unwrap();
+        let wrong = (0..60)
+            .flat_map(|y| (0..80).map(move |x| (x, y)))
+            .filter(|&(x, y)| (grid.label(x, y) == 1) != inside(x, y))
+            .count();
+        assert!(
+            wrong < 4800 / 20,
+            "{classifier}: {wrong} of 4 800 pixels on the wrong side"
+        );
+    }
+}
+
 #[test]
 fn noise_has_too_many_values_for_a_label_map() {
     let img = DynamicImage::ImageRgb8(RgbImage::from_fn(64, 64, |x, y| {
