@@ -6,9 +6,11 @@
 use std::io::Cursor;
 use std::path::Path;
 
+use image::metadata::Orientation;
 use image::{DynamicImage, ImageBuffer};
 use rayon::prelude::*;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::tags::Tag;
 
 use crate::ClassifyError;
 
@@ -41,7 +43,7 @@ pub(crate) fn decode_grey_tiff(
 }
 
 fn decode_checked(
-    decoder: Decoder<Cursor<&[u8]>>,
+    mut decoder: Decoder<Cursor<&[u8]>>,
     path: &Path,
     width: u32,
     height: u32,
@@ -57,6 +59,14 @@ fn decode_checked(
     limits.decoding_buffer_size = usize::try_from(max_pixels.saturating_mul(8))
         .unwrap_or(usize::MAX)
         .max(1 << 20);
+    // As the `image` crate reads it for the TIFFs it decodes.
+    let orientation = decoder
+        .find_tag(Tag::Orientation)
+        .ok()
+        .flatten()
+        .and_then(|v| v.into_u16().ok())
+        .and_then(|v| Orientation::from_exif(v.min(255) as u8))
+        .unwrap_or(Orientation::NoTransforms);
     let samples = decoder
         .with_limits(limits)
         .read_image()
@@ -74,9 +84,11 @@ fn decode_checked(
         DecodingResult::F32(v) => to_grey16(v, f64::from),
         DecodingResult::F64(v) => to_grey16(v, |x| x),
     };
-    ImageBuffer::from_raw(width, height, grey)
+    let mut image = ImageBuffer::from_raw(width, height, grey)
         .map(DynamicImage::ImageLuma16)
-        .ok_or_else(|| failed(format!("fewer samples than its {width}×{height} pixels")))
+        .ok_or_else(|| failed(format!("fewer samples than its {width}×{height} pixels")))?;
+    image.apply_orientation(orientation);
+    Ok(image)
 }
 
 /// Grey values of any type brought to 16 bits, in their order, keeping apart every two that

@@ -3,7 +3,8 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use image::{DynamicImage, ImageFormat, ImageReader, Limits};
+use image::metadata::Orientation;
+use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader, Limits};
 
 use crate::grey_tiff::{decode_grey_tiff, is_tiff};
 use crate::ClassifyError;
@@ -14,8 +15,8 @@ pub const DEFAULT_MAX_PIXELS: u64 = 1 << 28;
 /// Loads any image the `image` crate decodes (PNG, JPEG, TIFF, BMP, PNM; 8 or 16 bits; grey,
 /// grey + alpha, RGB, RGBA), and grey TIFFs of any sample type (signed, 32- or 64-bit integers,
 /// floating point: brought to 16-bit grey, whole values from 0 to 65 535 kept as they are,
-/// others stretched over the 16 bits in their order), refusing images over `max_pixels`
-/// before decoding them.
+/// others stretched over the 16 bits in their order), turned as its EXIF or TIFF orientation
+/// says (a photograph as it is shown), refusing images over `max_pixels` before decoding them.
 ///
 /// # Errors
 /// [`ClassifyError::Io`] (missing file), [`ClassifyError::Decode`] (not an image, truncated),
@@ -85,8 +86,15 @@ fn decode(bytes: &[u8], path: &Path, max_pixels: u64) -> Result<DynamicImage, Cl
         let mut limits = Limits::default();
         // 16 bytes per pixel covers RGBA at 32-bit float, the widest layout decoded here.
         limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 20));
-        reader.limits(limits);
-        reader.decode().map_err(decode)
+        reader.limits(limits.clone());
+        let mut decoder = reader.into_decoder().map_err(decode)?;
+        limits.reserve(decoder.total_bytes()).map_err(decode)?;
+        // A camera records how it was held (EXIF orientation) rather than turning the pixels:
+        // the regions are meshed as the image is shown. A broken tag leaves it as stored.
+        let orientation = decoder.orientation().unwrap_or(Orientation::NoTransforms);
+        let mut image = DynamicImage::from_decoder(decoder).map_err(decode)?;
+        image.apply_orientation(orientation);
+        Ok(image)
     };
     let image = match with_image() {
         // The grey TIFFs the `image` crate leaves out (signed, 32- or 64-bit, floating point).

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use image::{DynamicImage, GenericImageView, ImageBuffer, Luma, LumaA, Rgb, RgbImage};
+use image::{DynamicImage, GenericImageView, GrayImage, ImageBuffer, Luma, LumaA, Rgb, RgbImage};
 use imesh_classify::{
     classify, kmeans, label_map, load_image, looks_like_label_map, majority_filter,
     multi_otsu_levels, remove_small_regions, Classifier, ClassifyError, ClassifyOptions, LabelGrid,
@@ -288,6 +288,67 @@ fn grey_tiffs_of_every_sample_type_load() {
     std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
     let e = load_image(&cut, DEFAULT_MAX_PIXELS).unwrap_err();
     assert!(matches!(e, ClassifyError::Decode { .. }), "{e}");
+}
+
+/// The CRC of a PNG chunk's type and data.
+fn png_crc(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn a_photograph_is_meshed_as_its_orientation_tag_shows_it() {
+    let scratch = temp_dir();
+    let dir = scratch.path();
+    // 3 × 2 pixels, the stored top-left one white; EXIF orientation 6: shown turned 90°
+    // clockwise, 2 × 3, the white pixel at the top right.
+    let stored = GrayImage::from_fn(3, 2, |x, y| Luma([if (x, y) == (0, 0) { 255 } else { 0 }]));
+    let mut png = Vec::new();
+    stored
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    // A big-endian TIFF header and one IFD entry: Orientation (0x0112), SHORT, 1 value, 6.
+    let exif: [u8; 26] = [
+        b'M', b'M', 0, 42, 0, 0, 0, 8, 0, 1, 0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, 6, 0, 0, 0, 0, 0, 0,
+    ];
+    let mut chunk = (exif.len() as u32).to_be_bytes().to_vec();
+    let typed: Vec<u8> = b"eXIf".iter().chain(&exif).copied().collect();
+    chunk.extend(&typed);
+    chunk.extend(png_crc(&typed).to_be_bytes());
+    // After the signature and IHDR (8 + 25 bytes).
+    png.splice(33..33, chunk);
+    let p = dir.join("turned.png");
+    std::fs::write(&p, &png).unwrap();
+    let shown = load_image(&p, DEFAULT_MAX_PIXELS).unwrap().to_luma8();
+    assert_eq!(shown.dimensions(), (2, 3));
+    assert_eq!(shown.as_raw(), &[0, 255, 0, 0, 0, 0]);
+    // A grey TIFF the `tiff` crate reads, with the same tag.
+    let p = dir.join("turned-f32.tif");
+    {
+        let file = std::fs::File::create(&p).unwrap();
+        let mut tiff = tiff::encoder::TiffEncoder::new(file).unwrap();
+        let mut image = tiff
+            .new_image::<tiff::encoder::colortype::Gray32Float>(3, 2)
+            .unwrap();
+        image
+            .encoder()
+            .write_tag(tiff::tags::Tag::Orientation, 6u16)
+            .unwrap();
+        image.write_data(&[0.5, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+    }
+    let shown = load_image(&p, DEFAULT_MAX_PIXELS).unwrap().to_luma16();
+    assert_eq!(shown.dimensions(), (2, 3));
+    assert_eq!(shown.as_raw(), &[0, 65535, 0, 0, 0, 0]);
 }
 
 #[test]
