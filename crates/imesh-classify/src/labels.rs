@@ -9,7 +9,7 @@ use crate::grid::{palette_colour, Region};
 use crate::{ClassifyError, LabelGrid};
 
 /// Whether the image is grey (its values, not colours, are the labels).
-fn is_grey(image: &DynamicImage) -> bool {
+pub(crate) fn is_grey(image: &DynamicImage) -> bool {
     matches!(
         image,
         DynamicImage::ImageLuma8(_)

@@ -26,6 +26,7 @@
 
 mod cleanup;
 mod depth;
+mod dominant;
 mod error;
 mod grey_tiff;
 mod grid;
@@ -41,11 +42,12 @@ use image::DynamicImage;
 
 pub use cleanup::{majority_filter, pixel_regions, remove_small_regions, PixelRegion};
 pub use depth::eight_bit;
+pub use dominant::{dominant_colours, COLOUR_SPREAD, DOMINANT_SHARE};
 pub use error::ClassifyError;
 pub use grid::{LabelGrid, Region};
 pub use kmeans::kmeans;
 pub use labels::{label_map, looks_like_label_map};
-pub use load::{decode_image, load_image, DEFAULT_MAX_PIXELS};
+pub use load::{decode_image, is_lossy_file, load_image, DEFAULT_MAX_PIXELS};
 pub use reduce::reduce;
 pub use spec::Classifier;
 pub use texture::{SampleLabel, TextureClassifier, TextureSamples};
@@ -56,6 +58,9 @@ pub use threshold::{luminance, multi_otsu_levels, threshold};
 pub struct ClassifyOptions {
     /// Most distinct values a label map may have (default [`DEFAULT_MAX_LABELS`]).
     pub max_labels: usize,
+    /// The image was stored with a lossy codec ([`is_lossy_file`]): `auto` then reads a
+    /// label-like image by its dominant colours ([`dominant_colours`]) rather than every colour.
+    pub lossy: bool,
 }
 
 /// Default [`ClassifyOptions::max_labels`]: 65 536, every value of a 16-bit label map (instance
@@ -66,6 +71,7 @@ impl Default for ClassifyOptions {
     fn default() -> Self {
         Self {
             max_labels: DEFAULT_MAX_LABELS,
+            lossy: false,
         }
     }
 }
@@ -83,7 +89,11 @@ pub fn classify(
     match classifier {
         Classifier::Auto => {
             if looks_like_label_map(image, options.max_labels) {
-                label_map(image, options.max_labels)
+                if options.lossy {
+                    Ok(dominant_colours(image))
+                } else {
+                    label_map(image, options.max_labels)
+                }
             } else {
                 classify(image, &Classifier::Otsu { classes: 2 }, options)
             }

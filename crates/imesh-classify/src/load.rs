@@ -55,6 +55,57 @@ pub fn decode_image(bytes: &[u8], max_pixels: u64) -> Result<DynamicImage, Class
     decode(bytes, Path::new("<memory>"), max_pixels)
 }
 
+/// Whether the file at `path` was stored with a lossy codec: JPEG, WebP with a lossy (VP8)
+/// bitstream, or AVIF. False for anything else, and when the file cannot be read.
+///
+/// ```
+/// let dir = tempfile::tempdir()?;
+/// let (jpeg, webp) = (dir.path().join("a.jpg"), dir.path().join("b.webp"));
+/// std::fs::write(&jpeg, [0xff, 0xd8, 0xff, 0xe0])?;
+/// std::fs::write(&webp, b"RIFF\x1a\0\0\0WEBPVP8L")?;
+/// assert!(imesh_classify::is_lossy_file(&jpeg));
+/// assert!(!imesh_classify::is_lossy_file(&webp)); // VP8L: lossless
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn is_lossy_file(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let Ok(mut file) = std::fs::File::open(path) else {
+        return false;
+    };
+    let mut head = [0u8; 16];
+    if file.read_exact(&mut head).is_err() {
+        // Shorter than any WebP or AVIF header; a JPEG's first three bytes may still be there.
+        return std::fs::read(path).is_ok_and(|b| b.starts_with(&[0xff, 0xd8, 0xff]));
+    }
+    if head.starts_with(&[0xff, 0xd8, 0xff]) {
+        return true;
+    }
+    if &head[4..8] == b"ftyp" {
+        return matches!(&head[8..12], b"avif" | b"avis");
+    }
+    if &head[..4] != b"RIFF" || &head[8..12] != b"WEBP" {
+        return false;
+    }
+    // The chunks after "WEBP": a lossy image has a "VP8 " one (after "VP8X" and others in the
+    // extended format), a lossless one "VP8L".
+    let mut at = 12u64;
+    for _ in 0..16 {
+        let mut chunk = [0u8; 8];
+        if file.seek(SeekFrom::Start(at)).is_err() || file.read_exact(&mut chunk).is_err() {
+            return false;
+        }
+        match &chunk[..4] {
+            b"VP8 " => return true,
+            b"VP8L" => return false,
+            _ => {}
+        }
+        let size = u64::from(u32::from_le_bytes([chunk[4], chunk[5], chunk[6], chunk[7]]));
+        // Chunks are padded to an even size.
+        at += 8 + size + (size & 1);
+    }
+    false
+}
+
 /// Reads the header first, so that an image over the limit is refused before any pixel is
 /// decoded, then decodes with an allocation limit in case the header lied.
 fn decode(bytes: &[u8], path: &Path, max_pixels: u64) -> Result<DynamicImage, ClassifyError> {

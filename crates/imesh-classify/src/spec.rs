@@ -16,7 +16,8 @@ use crate::ClassifyError;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Classifier {
     /// `labels` for an image that looks like a label map (few distinct values in large flat
-    /// regions), `otsu` otherwise.
+    /// regions; its dominant colours when it was stored with a lossy codec, see
+    /// [`crate::ClassifyOptions::lossy`]), `otsu` otherwise.
     Auto,
     /// Each distinct grey value or colour is a label.
     Labels,

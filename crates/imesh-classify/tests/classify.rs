@@ -380,6 +380,76 @@ fn a_deep_image_using_few_of_its_levels_is_classified_on_its_own_range() {
 }
 
 #[test]
+fn a_flat_picture_stored_as_jpeg_is_read_by_its_dominant_colours() {
+    let scratch = temp_dir();
+    let dir = scratch.path();
+    // Three flat greys: a dark disc and a mid-grey bar on white, saved as a JPEG of quality
+    // 90 (its flat blocks come back exact: a label map to `auto`).
+    let truth = |x: u32, y: u32| {
+        if (x as i32 - 160).pow(2) + (y as i32 - 160).pow(2) < 10_000 {
+            0
+        } else if (300..380).contains(&x) {
+            1
+        } else {
+            2
+        }
+    };
+    let greys = [30, 120, 255];
+    let img = GrayImage::from_fn(400, 320, |x, y| Luma([greys[truth(x, y)]]));
+    let path = dir.join("flat.jpg");
+    let file = std::fs::File::create(&path).unwrap();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(file, 90)
+        .encode_image(&img)
+        .unwrap();
+    let loaded = load_image(&path, DEFAULT_MAX_PIXELS).unwrap();
+    assert!(imesh_classify::is_lossy_file(&path));
+    // Every grey a label: the codec's shades along the edges make dozens of them.
+    let every = classify(&loaded, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
+    assert!(every.num_labels() > 10, "{} labels", every.num_labels());
+    let options = ClassifyOptions {
+        lossy: true,
+        ..ClassifyOptions::default()
+    };
+    let grid = classify(&loaded, &Classifier::Auto, &options).unwrap();
+    assert_eq!(grid.num_labels(), 3);
+    let wrong = (0..320)
+        .flat_map(|y| (0..400).map(move |x| (x, y)))
+        .filter(|&(x, y)| grid.label(x, y) as usize != truth(x, y))
+        .count();
+    assert!(
+        wrong < 128_000 / 100,
+        "{wrong} of 128 000 pixels mislabelled"
+    );
+    // A lossless file of the same picture is not lossy.
+    let png = dir.join("flat.png");
+    img.save(&png).unwrap();
+    assert!(!imesh_classify::is_lossy_file(&png));
+}
+
+#[test]
+fn lossy_webp_and_avif_are_told_from_lossless_ones() {
+    let scratch = temp_dir();
+    let dir = scratch.path();
+    let lossy = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        imesh_classify::is_lossy_file(&p)
+    };
+    assert!(lossy("a.webp", b"RIFF\x20\0\0\0WEBPVP8 \x0a\0\0\0"));
+    assert!(!lossy("b.webp", b"RIFF\x20\0\0\0WEBPVP8L\x0a\0\0\0"));
+    // The extended format: a VP8X chunk of 10 bytes, then an odd-sized ALPH chunk (padded),
+    // then the bitstream.
+    let mut extended = b"RIFF\0\0\0\0WEBPVP8X\x0a\0\0\0".to_vec();
+    extended.extend([0; 10]);
+    extended.extend(b"ALPH\x03\0\0\0\x01\x02\x03\0VP8 \x04\0\0\0");
+    assert!(lossy("c.webp", &extended));
+    assert!(lossy("d.avif", b"\0\0\0\x20ftypavif\0\0\0\0"));
+    assert!(!lossy("e.bin", b"not an image at all"));
+    assert!(!lossy("f.jpg", b"\xff\xd8"));
+    assert!(!imesh_classify::is_lossy_file(&dir.join("missing.jpg")));
+}
+
+#[test]
 fn noise_has_too_many_values_for_a_label_map() {
     let img = DynamicImage::ImageRgb8(RgbImage::from_fn(64, 64, |x, y| {
         Rgb([x as u8 * 4, y as u8 * 4, (x * y) as u8])

@@ -916,7 +916,7 @@ impl Pipeline {
         let start = Instant::now();
         self.stage(Stage::Classify);
         let image = load_image(path, self.options.max_pixels)?;
-        let mut result = self.classify_and_run(&image)?;
+        let mut result = self.classify_and_run(&image, imesh_classify::is_lossy_file(path))?;
         let load = start.elapsed().as_secs_f64() - result.report.seconds.total;
         result.report.seconds.classify += load;
         result.report.seconds.total += load;
@@ -924,18 +924,20 @@ impl Pipeline {
         Ok(result)
     }
 
-    /// Meshes a decoded image.
+    /// Meshes a decoded image (as losslessly stored: see [`ClassifyOptions::lossy`]).
     ///
     /// # Errors
     /// [`PipelineError`], each saying what to change.
     pub fn run_image(&self, image: &image::DynamicImage) -> Result<PipelineResult, PipelineError> {
         self.stage(Stage::Classify);
-        self.classify_and_run(image)
+        self.classify_and_run(image, false)
     }
 
+    /// Classifies `image` (stored with a lossy codec when `lossy`) and meshes its labels.
     fn classify_and_run(
         &self,
         image: &image::DynamicImage,
+        lossy: bool,
     ) -> Result<PipelineResult, PipelineError> {
         let o = &self.options;
         self.check_options()?;
@@ -946,6 +948,7 @@ impl Pipeline {
             &classifier,
             &ClassifyOptions {
                 max_labels: o.max_labels,
+                lossy,
             },
         )?;
         let t_classify = start.elapsed().as_secs_f64();

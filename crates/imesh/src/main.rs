@@ -930,8 +930,11 @@ fn classify_command(args: &ClassifyArgs) -> Result<(), String> {
         .classify
         .parse()
         .map_err(|e: imesh_classify::ClassifyError| e.to_string())?;
-    let grid =
-        classify(&image, &classifier, &ClassifyOptions::default()).map_err(|e| e.to_string())?;
+    let options = ClassifyOptions {
+        lossy: imesh_classify::is_lossy_file(&args.image),
+        ..ClassifyOptions::default()
+    };
+    let grid = classify(&image, &classifier, &options).map_err(|e| e.to_string())?;
     check_png(&args.output)?;
     grid.save_png(&args.output).map_err(|e| e.to_string())?;
     println!(

@@ -1,0 +1,111 @@
+//! Label-like images stored with a lossy codec (JPEG, lossy WebP or AVIF): a flat-coloured
+//! picture comes back with dozens of colours, a few levels off its own, rung around every
+//! edge and spread over each block. Read as a label map, those become labels of their own,
+//! bands a few pixels wide along every boundary. Here every pixel takes the nearest of the
+//! picture's dominant colours instead.
+
+use std::collections::HashMap;
+
+use image::DynamicImage;
+use rayon::prelude::*;
+
+use crate::grid::{palette_colour, Region};
+use crate::labels::is_grey;
+use crate::LabelGrid;
+
+/// Colours this close (in every channel, 8 bits) are one label's: a lossy codec moves flat
+/// colours by a few levels, and its ringing by up to a few tens next to strong edges.
+pub const COLOUR_SPREAD: u8 = 32;
+
+/// A colour is a label of its own only when at least this share of the pixels has it.
+pub const DOMINANT_SHARE: f64 = 0.002;
+
+/// Labels each pixel by the nearest of the image's dominant colours: the most common colour,
+/// then, by decreasing count, every colour held by at least [`DOMINANT_SHARE`] of the pixels and
+/// farther than [`COLOUR_SPREAD`] from those already taken. Labels are numbered in increasing
+/// colour order and named as [`crate::label_map`] names them (`value V`, `#rrggbb`).
+///
+/// ```
+/// use image::{DynamicImage, Rgb, RgbImage};
+/// // Two flat colours, with the stray shades a codec leaves along their edge.
+/// let img = RgbImage::from_fn(100, 10, |x, _| match x {
+///     0..=48 => Rgb([200, 30, 30]),
+///     49 => Rgb([190, 40, 35]),
+///     50 => Rgb([20, 45, 190]),
+///     _ => Rgb([10, 40, 200]),
+/// });
+/// let grid = imesh_classify::dominant_colours(&DynamicImage::ImageRgb8(img));
+/// assert_eq!(grid.num_labels(), 2);
+/// assert_eq!((grid.label(49, 0), grid.label(50, 0)), (1, 0));
+/// assert_eq!(grid.regions()[0].name, "#0a28c8");
+/// ```
+pub fn dominant_colours(image: &DynamicImage) -> LabelGrid {
+    let rgb = crate::eight_bit(image).to_rgb8();
+    let keys: Vec<u32> = rgb
+        .pixels()
+        .map(|p| (u32::from(p[0]) << 16) | (u32::from(p[1]) << 8) | u32::from(p[2]))
+        .collect();
+    let mut counts: HashMap<u32, usize> = HashMap::new();
+    for run in keys.chunk_by(|a, b| a == b) {
+        *counts.entry(run[0]).or_default() += run.len();
+    }
+    let mut by_count: Vec<(u32, usize)> = counts.into_iter().collect();
+    by_count.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let least = (DOMINANT_SHARE * keys.len() as f64).ceil() as usize;
+    let mut palette: Vec<u32> = Vec::new();
+    for (i, &(c, n)) in by_count.iter().enumerate() {
+        if i == 0 || (n >= least && palette.iter().all(|&p| spread(p, c) > COLOUR_SPREAD)) {
+            palette.push(c);
+        }
+    }
+    palette.sort_unstable();
+    let label_of: HashMap<u32, u32> = by_count
+        .iter()
+        .map(|&(c, _)| (c, nearest(&palette, c)))
+        .collect();
+    let labels: Vec<u32> = keys.par_iter().map(|k| label_of[k]).collect();
+    let grey = is_grey(image);
+    let regions = palette
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let [r, g, b] = channels(c);
+            if grey {
+                Region {
+                    name: format!("value {r}"),
+                    colour: palette_colour(i),
+                }
+            } else {
+                Region {
+                    name: format!("#{r:02x}{g:02x}{b:02x}"),
+                    colour: [r, g, b],
+                }
+            }
+        })
+        .collect();
+    LabelGrid::new(rgb.width(), rgb.height(), labels, regions)
+        .expect("every pixel takes a palette entry")
+}
+
+fn channels(c: u32) -> [u8; 3] {
+    [(c >> 16) as u8, (c >> 8) as u8, c as u8]
+}
+
+/// The largest difference of two colours in one channel.
+fn spread(a: u32, b: u32) -> u8 {
+    let (a, b) = (channels(a), channels(b));
+    (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap_or(0)
+}
+
+/// The palette entry nearest `c` (squared distance in RGB; the first of equals).
+fn nearest(palette: &[u32], c: u32) -> u32 {
+    let distance = |p: u32| {
+        let (a, b) = (channels(p), channels(c));
+        (0..3)
+            .map(|k| (i32::from(a[k]) - i32::from(b[k])).pow(2))
+            .sum::<i32>()
+    };
+    (0..palette.len() as u32)
+        .min_by_key(|&i| distance(palette[i as usize]))
+        .unwrap_or(0)
+}
