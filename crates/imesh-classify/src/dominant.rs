@@ -9,8 +9,7 @@ use std::collections::HashMap;
 use image::DynamicImage;
 use rayon::prelude::*;
 
-use crate::grid::{palette_colour, Region};
-use crate::labels::is_grey;
+use crate::labels::{is_grey, named_region};
 use crate::LabelGrid;
 
 /// Colours this close (in every channel, 8 bits) are one label's: a lossy codec moves flat
@@ -69,18 +68,8 @@ pub fn dominant_colours(image: &DynamicImage) -> LabelGrid {
         .iter()
         .enumerate()
         .map(|(i, &c)| {
-            let [r, g, b] = channels(c);
-            if grey {
-                Region {
-                    name: format!("value {r}"),
-                    colour: palette_colour(i),
-                }
-            } else {
-                Region {
-                    name: format!("#{r:02x}{g:02x}{b:02x}"),
-                    colour: [r, g, b],
-                }
-            }
+            let rgb = channels(c);
+            named_region(i, grey.then_some(u16::from(rgb[0])), rgb)
         })
         .collect();
     LabelGrid::new(rgb.width(), rgb.height(), labels, regions)

@@ -19,6 +19,21 @@ pub(crate) fn is_grey(image: &DynamicImage) -> bool {
     )
 }
 
+/// Label `i`'s region, named by its grey value (drawn in the palette's `i`-th colour) or, with
+/// no grey value, by its colour `rgb` (drawn in it).
+pub(crate) fn named_region(i: usize, grey: Option<u16>, rgb: [u8; 3]) -> Region {
+    match grey {
+        Some(v) => Region {
+            name: format!("value {v}"),
+            colour: palette_colour(i),
+        },
+        None => Region {
+            name: format!("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]),
+            colour: rgb,
+        },
+    }
+}
+
 /// One `u64` per pixel that is equal exactly when the pixels are (16 bits per channel).
 fn pixel_keys(image: &DynamicImage) -> Vec<u64> {
     if is_grey(image) {
@@ -93,19 +108,9 @@ pub fn label_map(image: &DynamicImage, max_labels: usize) -> Result<LabelGrid, C
         .map(|(i, &k)| {
             let channel = |c: u32| ((k >> (16 * c)) & 0xffff) as u16;
             let to8 = |v: u16| (v >> 8) as u8;
-            if grey {
-                let v = if deep { channel(0) } else { channel(0) / 257 };
-                Region {
-                    name: format!("value {v}"),
-                    colour: palette_colour(i),
-                }
-            } else {
-                let rgb = [to8(channel(0)), to8(channel(1)), to8(channel(2))];
-                Region {
-                    name: format!("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]),
-                    colour: rgb,
-                }
-            }
+            let value = if deep { channel(0) } else { channel(0) / 257 };
+            let rgb = [to8(channel(0)), to8(channel(1)), to8(channel(2))];
+            named_region(i, grey.then_some(value), rgb)
         })
         .collect();
     let index: HashMap<u64, u32> = distinct
