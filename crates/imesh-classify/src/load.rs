@@ -72,13 +72,16 @@ pub fn is_lossy_file(path: &Path) -> bool {
     let Ok(mut file) = std::fs::File::open(path) else {
         return false;
     };
-    let mut head = [0u8; 16];
-    if file.read_exact(&mut head).is_err() {
-        // Shorter than any WebP or AVIF header; a JPEG's first three bytes may still be there.
-        return std::fs::read(path).is_ok_and(|b| b.starts_with(&[0xff, 0xd8, 0xff]));
+    let mut head = Vec::with_capacity(16);
+    if (&mut file).take(16).read_to_end(&mut head).is_err() {
+        return false;
     }
     if head.starts_with(&[0xff, 0xd8, 0xff]) {
         return true;
+    }
+    // Shorter than any WebP or AVIF header.
+    if head.len() < 16 {
+        return false;
     }
     if &head[4..8] == b"ftyp" {
         return matches!(&head[8..12], b"avif" | b"avis");
