@@ -4,11 +4,10 @@
 //! bands a few pixels wide along every boundary. Here every pixel takes the nearest of the
 //! picture's dominant colours instead.
 
-use std::collections::HashMap;
-
 use image::DynamicImage;
 use rayon::prelude::*;
 
+use crate::colours::{self, channels};
 use crate::labels::{is_grey, named_region};
 use crate::LabelGrid;
 
@@ -40,15 +39,9 @@ pub const DOMINANT_SHARE: f64 = 0.002;
 /// ```
 pub fn dominant_colours(image: &DynamicImage) -> LabelGrid {
     let rgb = crate::eight_bit(image).to_rgb8();
-    let keys: Vec<u32> = rgb
-        .pixels()
-        .map(|p| (u32::from(p[0]) << 16) | (u32::from(p[1]) << 8) | u32::from(p[2]))
-        .collect();
-    let mut counts: HashMap<u32, usize> = HashMap::new();
-    for run in keys.chunk_by(|a, b| a == b) {
-        *counts.entry(run[0]).or_default() += run.len();
-    }
-    let mut by_count: Vec<(u32, usize)> = counts.into_iter().collect();
+    let keys = colours::packed(&rgb);
+    let distinct = colours::distinct(&keys);
+    let mut by_count = distinct.clone();
     by_count.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     let least = (DOMINANT_SHARE * keys.len() as f64).ceil() as usize;
     let mut palette: Vec<u32> = Vec::new();
@@ -58,11 +51,20 @@ pub fn dominant_colours(image: &DynamicImage) -> LabelGrid {
         }
     }
     palette.sort_unstable();
-    let label_of: HashMap<u32, u32> = by_count
+    // Per distinct colour (in increasing order), its palette entry.
+    let label_of: Vec<u32> = distinct
         .iter()
-        .map(|&(c, _)| (c, nearest(&palette, c)))
+        .map(|&(c, _)| nearest(&palette, c))
         .collect();
-    let labels: Vec<u32> = keys.par_iter().map(|k| label_of[k]).collect();
+    let labels: Vec<u32> = keys
+        .par_iter()
+        .map(|k| {
+            let i = distinct
+                .binary_search_by_key(k, |&(c, _)| c)
+                .expect("every pixel colour is a distinct colour");
+            label_of[i]
+        })
+        .collect();
     let grey = is_grey(image);
     let regions = palette
         .iter()
@@ -74,10 +76,6 @@ pub fn dominant_colours(image: &DynamicImage) -> LabelGrid {
         .collect();
     LabelGrid::new(rgb.width(), rgb.height(), labels, regions)
         .expect("every pixel takes a palette entry")
-}
-
-fn channels(c: u32) -> [u8; 3] {
-    [(c >> 16) as u8, (c >> 8) as u8, c as u8]
 }
 
 /// The largest difference of two colours in one channel.

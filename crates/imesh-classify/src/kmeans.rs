@@ -9,6 +9,7 @@ use rand_chacha::rand_core::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use crate::colours;
 use crate::grid::Region;
 use crate::LabelGrid;
 
@@ -17,7 +18,8 @@ const SEED: u64 = 0x1_3e54;
 const MAX_ITERATIONS: usize = 100;
 
 fn lab_of(rgb: u32) -> [f32; 3] {
-    let c = Srgb::new((rgb >> 16) as u8, (rgb >> 8) as u8, rgb as u8).into_format::<f32>();
+    let [r, g, b] = colours::channels(rgb);
+    let c = Srgb::new(r, g, b).into_format::<f32>();
     let lab: Lab = c.into_linear().into_color();
     [lab.l, lab.a, lab.b]
 }
@@ -81,24 +83,11 @@ fn seed_centres(points: &[[f32; 3]], weights: &[f64], k: usize) -> Vec<[f32; 3]>
 /// ([`crate::eight_bit`]).
 pub fn kmeans(image: &DynamicImage, k: usize) -> LabelGrid {
     let rgb = crate::eight_bit(image).to_rgb8();
-    let keys: Vec<u32> = rgb
-        .as_raw()
-        .par_chunks_exact(3)
-        .map(|p| (u32::from(p[0]) << 16) | (u32::from(p[1]) << 8) | u32::from(p[2]))
-        .collect();
-    let mut sorted = keys.clone();
-    sorted.par_sort_unstable();
-    let mut colours: Vec<u32> = Vec::new();
-    let mut weights: Vec<f64> = Vec::new();
-    for &c in &sorted {
-        if colours.last() == Some(&c) {
-            *weights.last_mut().expect("pushed with its colour") += 1.0;
-        } else {
-            colours.push(c);
-            weights.push(1.0);
-        }
-    }
-    drop(sorted);
+    let keys = colours::packed(&rgb);
+    let (colours, weights): (Vec<u32>, Vec<f64>) = colours::distinct(&keys)
+        .into_iter()
+        .map(|(c, n)| (c, n as f64))
+        .unzip();
     let points: Vec<[f32; 3]> = colours.par_iter().map(|&c| lab_of(c)).collect();
     let mut centres = seed_centres(&points, &weights, k);
     let mut assign: Vec<usize> = vec![usize::MAX; points.len()];
@@ -140,9 +129,9 @@ pub fn kmeans(image: &DynamicImage, k: usize) -> LabelGrid {
     // Mean sRGB colour of each cluster, for display.
     let mut mean = vec![[0f64; 4]; centres.len()];
     for ((&c, &a), &w) in colours.iter().zip(&assign).zip(&weights) {
-        mean[a][0] += f64::from((c >> 16) as u8) * w;
-        mean[a][1] += f64::from((c >> 8) as u8) * w;
-        mean[a][2] += f64::from(c as u8) * w;
+        for (d, v) in colours::channels(c).into_iter().enumerate() {
+            mean[a][d] += f64::from(v) * w;
+        }
         mean[a][3] += w;
     }
     let regions: Vec<Region> = order

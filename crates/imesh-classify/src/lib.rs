@@ -25,6 +25,7 @@
 #![warn(missing_docs)]
 
 mod cleanup;
+mod colours;
 mod depth;
 mod dominant;
 mod error;
