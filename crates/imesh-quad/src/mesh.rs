@@ -417,15 +417,15 @@ impl QuadMesh {
         valid_above(&self.quads[q].map(|v| self.vertices[v as usize]), floor)
     }
 
-    /// Whether every quad of element `index` would pass [`QuadMesh::is_valid_above`] at its
-    /// floor (`floors[x]` for quad `x` of the mesh) if the element's patch had the control
-    /// points `patch` (by slot): its template points, those on its sides too, are evaluated
-    /// from `patch` into a scratch buffer; nothing is written.
+    /// Whether every quad of element `index` would pass `passes` (given the quad's index in the
+    /// mesh and its corners) if the element's patch had the control points `patch` (by slot):
+    /// its template points, those on its sides too, are evaluated from `patch` into a scratch
+    /// buffer; nothing is written.
     pub(crate) fn element_valid_with(
         &self,
         index: usize,
         patch: &[Point; 16],
-        floors: &[f64],
+        passes: impl Fn(usize, &[Point; 4]) -> bool,
     ) -> bool {
         let template = self.template_of(index);
         let points: Vec<Point> = template
@@ -437,8 +437,8 @@ impl QuadMesh {
         template
             .quads
             .iter()
-            .zip(&floors[first..])
-            .all(|(quad, &floor)| valid_above(&quad.map(|i| points[i as usize]), floor))
+            .zip(first..)
+            .all(|(quad, x)| passes(x, &quad.map(|i| points[i as usize])))
     }
 
     /// The total (signed) area of the quads.
