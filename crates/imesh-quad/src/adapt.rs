@@ -85,7 +85,7 @@ pub const POOR_SCALED_JACOBIAN: f64 = 0.5;
 /// straight template is valid, but may be poorer than the bar). The straight value is needed
 /// only for a quad under the bar, so it is computed from the straight template points
 /// (`straight`, the vertices before adaptation) only then: most adapted quads clear the bar,
-/// and computing it for every touched quad up front cost about 16 ms of CPU time on the
+/// and computing it for every touched quad up front cost some 20–30 ms of CPU time on the
 /// benchmark's 103 662 triangles of grass (8–11 ms of its adaptation on two threads).
 struct Floors {
     straight: Vec<Point>,
