@@ -87,11 +87,11 @@ pub const POOR_SCALED_JACOBIAN: f64 = 0.5;
 /// (`straight`, the vertices before adaptation) only then: most adapted quads clear the bar,
 /// and computing it for every touched quad up front cost some 20–30 ms of CPU time on the
 /// benchmark's 103 662 triangles of grass (8–11 ms of its adaptation on two threads).
-struct Floors {
-    straight: Vec<Point>,
+struct Floors<'a> {
+    straight: &'a [Point],
 }
 
-impl Floors {
+impl Floors<'_> {
     /// Whether quad `x` of `q`, with corners `p`, is valid and above its floor.
     fn passes(&self, q: &QuadMesh, x: usize, p: &[Point; 4]) -> bool {
         // Every floor is at most the bar's: a quad above the bar is above its floor.
@@ -131,6 +131,20 @@ pub fn adapt(
     adapt_within(dt, g, curves, m, net, q, LOCAL_ROUNDS)
 }
 
+/// [`adapt`] given the straight template points (`q`'s vertices as [`QuadMesh::build`] placed
+/// them), for a caller that keeps them anyway.
+pub(crate) fn adapt_from_straight(
+    dt: &RegionTriangulation,
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    m: &ElementMesh,
+    net: &mut ControlNet,
+    q: &mut QuadMesh,
+    straight: &[Point],
+) -> (AdaptReport, Vec<EdgeCurve>) {
+    adapt_rounds(dt, g, curves, m, net, q, straight, LOCAL_ROUNDS)
+}
+
 /// [`adapt`] with the damping near the poor elements limited to `local_rounds` rounds (the
 /// default is [`LOCAL_ROUNDS`]); from then on a poor element's G' edges are straightened
 /// whole. With 0, every G' edge a poor element needs damped is straightened at once: the
@@ -142,6 +156,22 @@ pub fn adapt_within(
     m: &ElementMesh,
     net: &mut ControlNet,
     q: &mut QuadMesh,
+    local_rounds: u32,
+) -> (AdaptReport, Vec<EdgeCurve>) {
+    let straight = q.vertices.clone();
+    adapt_rounds(dt, g, curves, m, net, q, &straight, local_rounds)
+}
+
+/// [`adapt_within`] given the straight template points.
+#[allow(clippy::too_many_arguments)]
+fn adapt_rounds(
+    dt: &RegionTriangulation,
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    m: &ElementMesh,
+    net: &mut ControlNet,
+    q: &mut QuadMesh,
+    straight: &[Point],
     local_rounds: u32,
 ) -> (AdaptReport, Vec<EdgeCurve>) {
     let t = &dt.triangulation;
@@ -216,9 +246,7 @@ pub fn adapt_within(
                     .any(|side| curve_of_edge[m.side_edge(index, side).0 as usize] != NONE)
         })
         .collect();
-    let floors = Floors {
-        straight: q.vertices.clone(),
-    };
+    let floors = Floors { straight };
     // Per round, which M edges it has evaluated.
     let mut edge_stamp = vec![0u32; m.edges.len()];
     let mut edges = Vec::new();

@@ -201,7 +201,15 @@ pub fn remesh(
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();
     let templates = clock.elapsed().as_secs_f64() - triangulation - pairing;
-    let (adaptation, edge_curves) = adapt(&dt, g, curves, &elements, &mut net, &mut mesh);
+    let (adaptation, edge_curves) = adapt::adapt_from_straight(
+        &dt,
+        g,
+        curves,
+        &elements,
+        &mut net,
+        &mut mesh,
+        &straight_vertices,
+    );
     mesh.snap_to_border(&dt.triangulation, &elements);
     let seconds = RemeshSeconds {
         triangulation,
