@@ -94,14 +94,21 @@ struct Floors<'a> {
 impl Floors<'_> {
     /// Whether quad `x` of `q`, with corners `p`, is valid and above its floor.
     fn passes(&self, q: &QuadMesh, x: usize, p: &[Point; 4]) -> bool {
-        // Every floor is at most the bar's: a quad above the bar is above its floor.
-        const MARGIN: f64 = 1e-9;
-        valid_above(p, POOR_SCALED_JACOBIAN - MARGIN)
-            || valid_above(p, {
-                let straight = q.quads[x].map(|v| self.straight[v as usize]);
-                POOR_SCALED_JACOBIAN.min(scaled_jacobian(&straight)) - MARGIN
-            })
+        above_floor(p, || q.quads[x].map(|v| self.straight[v as usize]))
     }
+}
+
+/// Whether the quad `p` is valid and above its floor, the scaled Jacobian
+/// [`POOR_SCALED_JACOBIAN`] or that of its straight corners (`straight`, asked for only if `p`
+/// is under the bar) where lower, less 10⁻⁹: the floor is at most the bar, so a quad above the
+/// bar is above its floor.
+fn above_floor(p: &[Point; 4], straight: impl FnOnce() -> [Point; 4]) -> bool {
+    const MARGIN: f64 = 1e-9;
+    valid_above(p, POOR_SCALED_JACOBIAN - MARGIN)
+        || valid_above(
+            p,
+            POOR_SCALED_JACOBIAN.min(scaled_jacobian(&straight())) - MARGIN,
+        )
 }
 
 /// Moves the control points of every M edge on a G' edge onto the exact piece of that edge's
@@ -887,5 +894,44 @@ impl Damping {
             }
         }
         damped.iter().filter(|&&d| d).count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The unit square's corners moved by `moves` (times `shift`).
+    fn jittered(moves: [(f64, f64); 4], shift: f64) -> [Point; 4] {
+        let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        std::array::from_fn(|i| {
+            Point::new(
+                square[i].0 + shift * moves[i].0,
+                square[i].1 + shift * moves[i].1,
+            )
+        })
+    }
+
+    proptest! {
+        /// Asking for the straight corners only under the bar decides as the floor computed
+        /// for every quad did: valid and at least `min(bar, straight) − 10⁻⁹`.
+        #[test]
+        fn the_floor_asked_for_under_the_bar_decides_as_the_eager_one(
+            adapted in proptest::array::uniform4((-1.0f64..1.0, -1.0f64..1.0)),
+            straight in proptest::array::uniform4((-1.0f64..1.0, -1.0f64..1.0)),
+            shift in 0.0f64..0.6,
+        ) {
+            let (p, s) = (jittered(adapted, shift), jittered(straight, shift / 2.0));
+            let eager = valid_above(&p, POOR_SCALED_JACOBIAN.min(scaled_jacobian(&s)) - 1e-9);
+            let mut asked = false;
+            let lazy = above_floor(&p, || {
+                asked = true;
+                s
+            });
+            prop_assert_eq!(lazy, eager);
+            // The straight corners are read only for a quad under the bar.
+            prop_assert_eq!(asked, !valid_above(&p, POOR_SCALED_JACOBIAN - 1e-9));
+        }
     }
 }
