@@ -512,26 +512,65 @@ impl Triangulation {
             if pieces.is_nan() || pieces < 2.0 {
                 continue;
             }
-            // Peel one piece off the front at a time: the next point splits what is left into
-            // the remaining number of equal parts, so rounding does not accumulate.
-            let mut at = u;
-            for left in (2..=pieces as usize).rev() {
-                let Some(h) = self
-                    .find_edge(VertexId(at), VertexId(w))
-                    .filter(|&h| self.is_constrained(h))
-                else {
-                    break;
-                };
-                let pa = self.points[at as usize];
-                let p = self.snap_to_segment(h.0, pa + (pw - pa) * (1.0 / left as f64));
-                let v = self.insert_on_edge(h.0, p)?.0;
-                if v == at || v == w {
-                    break;
-                }
-                at = v;
+            self.split_piece(u, w, pieces as usize)?;
+        }
+        Ok(self.points.len() - before)
+    }
+
+    /// Splits each constrained edge `(u, w, pieces)` of `splits` into `pieces` equal parts as
+    /// [`Triangulation::split_long_segments`] does (an edge that is not a constrained edge of
+    /// the triangulation, or is split already, is left), and returns the number of points
+    /// inserted.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(9.0, 0.0), Point::new(0.0, 3.0)];
+    /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    /// let s = t.insert_segment(v[0], v[1]).unwrap();
+    /// assert_eq!(t.split_segment_pieces(&[(v[0], v[1], 3), (v[0], v[2], 2)]).unwrap(), 2);
+    /// let xs: Vec<f64> = t.segment_vertices(s).iter().map(|&u| t.point(u).x).collect();
+    /// // On the segment (snapped to its line), a third of it apart up to rounding.
+    /// assert!(xs.iter().zip([0.0, 3.0, 6.0, 9.0]).all(|(x, want)| (x - want).abs() < 1e-9));
+    /// t.check().unwrap();
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Triangulation::split_long_segments`].
+    pub fn split_segment_pieces(
+        &mut self,
+        splits: &[(VertexId, VertexId, usize)],
+    ) -> Result<usize, GeomError> {
+        let before = self.points.len();
+        for &(u, w, pieces) in splits {
+            if pieces >= 2 {
+                self.split_piece(u.0, w.0, pieces)?;
             }
         }
         Ok(self.points.len() - before)
+    }
+
+    /// Splits the constrained edge from `u` to `w` into `pieces` equal parts.
+    fn split_piece(&mut self, u: u32, w: u32, pieces: usize) -> Result<(), GeomError> {
+        let pw = self.points[w as usize];
+        // Peel one piece off the front at a time: the next point splits what is left into
+        // the remaining number of equal parts, so rounding does not accumulate.
+        let mut at = u;
+        for left in (2..=pieces).rev() {
+            let Some(h) = self
+                .find_edge(VertexId(at), VertexId(w))
+                .filter(|&h| self.is_constrained(h))
+            else {
+                break;
+            };
+            let pa = self.points[at as usize];
+            let p = self.snap_to_segment(h.0, pa + (pw - pa) * (1.0 / left as f64));
+            let v = self.insert_on_edge(h.0, p)?.0;
+            if v == at || v == w {
+                break;
+            }
+            at = v;
+        }
+        Ok(())
     }
 
     /// Marks every hull edge as a segment (the domain border).
