@@ -542,8 +542,10 @@ fn assert_corners_held(before: &Remesh, after: &Remesh, cap: f64) {
 /// [`POOR_QUALITY`] than without it, and no quad of the mesh it starts from (the same run
 /// without it: it is the last step) falls under where it was, capped at [`QUALITY_BAR`]; no
 /// quad's shape or scaled Jacobian falls under where it was, capped at [`REPAIR_JACOBIAN`].
-/// Without the pipeline's clean-ups this mesh keeps strips thinner than its quads: 1 365 of
-/// its quads are under the bar, the poorest 2 % hopeless, and 6 are lifted over it (the
+/// Without the pipeline's clean-ups this mesh keeps strips thinner than its quads: 1 371 of
+/// its quads are under [`POOR_QUALITY`], the poorest 2 % hopeless; the repair raises the
+/// poorest patches (their total shortfall under [`QUALITY_BAR`] falls) though none crosses
+/// [`POOR_QUALITY`] here (6 did before thin strips' boundary pieces were cut to their depth; the
 /// pipeline's mesh of the same image: 222 → 83).
 #[test]
 fn the_quality_repair_lifts_the_poorest_quads() {
@@ -564,14 +566,20 @@ fn the_quality_repair_lifts_the_poorest_quads() {
         shape_and_size(&without, average),
     );
     let under = |s: &[f64]| s.iter().filter(|&&x| x < POOR_QUALITY).count();
+    // How far the quads are under the repair's bar, summed.
+    let shortfall = |s: &[f64]| s.iter().map(|&x| (QUALITY_BAR - x).max(0.0)).sum::<f64>();
     eprintln!(
-        "quads under {POOR_QUALITY}: {} → {}; mean shape-and-size {:.4} → {:.4}",
+        "quads under {POOR_QUALITY}: {} → {}; shortfall under {QUALITY_BAR}: {:.3} → {:.3}; \
+         mean shape-and-size {:.4} → {:.4}",
         under(&before),
         under(&after),
+        shortfall(&before),
+        shortfall(&after),
         without_report.after.shape_and_size.mean,
         with_report.after.shape_and_size.mean
     );
-    assert!(under(&after) < under(&before));
+    assert!(under(&after) <= under(&before));
+    assert!(shortfall(&after) < shortfall(&before));
     for q in 0..with.mesh.quads.len() {
         assert!(with.mesh.is_valid(q));
         // The optimiser's area is the shoelace one, Verdict's up to rounding.

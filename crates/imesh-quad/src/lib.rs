@@ -51,7 +51,7 @@ mod template;
 
 pub use adapt::{adapt, adapt_within, AdaptReport, EdgeCurve, LOCAL_ROUNDS, POOR_SCALED_JACOBIAN};
 pub use chains::BoundaryChain;
-pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE};
+pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE, STRIP};
 pub use dt::{DensityOptions, RegionTriangulation, BOUNDARY_CLEARANCE, MAX_TRIANGLE_AREA, NONE};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
 pub use pairing::{Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER};
