@@ -138,20 +138,6 @@ pub fn adapt(
     adapt_within(dt, g, curves, m, net, q, LOCAL_ROUNDS)
 }
 
-/// [`adapt`] given the straight template points (`q`'s vertices as [`QuadMesh::build`] placed
-/// them), for a caller that keeps them anyway.
-pub(crate) fn adapt_from_straight(
-    dt: &RegionTriangulation,
-    g: &CurveGraph,
-    curves: &[CubicBezier],
-    m: &ElementMesh,
-    net: &mut ControlNet,
-    q: &mut QuadMesh,
-    straight: &[Point],
-) -> (AdaptReport, Vec<EdgeCurve>) {
-    adapt_rounds(dt, g, curves, m, net, q, straight, LOCAL_ROUNDS)
-}
-
 /// [`adapt`] with the damping near the poor elements limited to `local_rounds` rounds (the
 /// default is [`LOCAL_ROUNDS`]); from then on a poor element's G' edges are straightened
 /// whole. With 0, every G' edge a poor element needs damped is straightened at once: the
@@ -169,9 +155,10 @@ pub fn adapt_within(
     adapt_rounds(dt, g, curves, m, net, q, &straight, local_rounds)
 }
 
-/// [`adapt_within`] given the straight template points.
+/// [`adapt_within`] given the straight template points (`q`'s vertices as [`QuadMesh::build`]
+/// placed them), for a caller that keeps them anyway.
 #[allow(clippy::too_many_arguments)]
-fn adapt_rounds(
+pub(crate) fn adapt_rounds(
     dt: &RegionTriangulation,
     g: &CurveGraph,
     curves: &[CubicBezier],

@@ -201,7 +201,7 @@ pub fn remesh(
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();
     let templates = clock.elapsed().as_secs_f64() - triangulation - pairing;
-    let (adaptation, edge_curves) = adapt::adapt_from_straight(
+    let (adaptation, edge_curves) = adapt::adapt_rounds(
         &dt,
         g,
         curves,
@@ -209,6 +209,7 @@ pub fn remesh(
         &mut net,
         &mut mesh,
         &straight_vertices,
+        LOCAL_ROUNDS,
     );
     mesh.snap_to_border(&dt.triangulation, &elements);
     let seconds = RemeshSeconds {
