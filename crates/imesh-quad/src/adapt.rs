@@ -135,30 +135,17 @@ pub fn adapt(
     net: &mut ControlNet,
     q: &mut QuadMesh,
 ) -> (AdaptReport, Vec<EdgeCurve>) {
-    adapt_within(dt, g, curves, m, net, q, LOCAL_ROUNDS)
-}
-
-/// [`adapt`] with the damping near the poor elements limited to `local_rounds` rounds (the
-/// default is [`LOCAL_ROUNDS`]); from then on a poor element's G' edges are straightened
-/// whole. With 0, every G' edge a poor element needs damped is straightened at once: the
-/// bluntest repair, for comparison.
-pub fn adapt_within(
-    dt: &RegionTriangulation,
-    g: &CurveGraph,
-    curves: &[CubicBezier],
-    m: &ElementMesh,
-    net: &mut ControlNet,
-    q: &mut QuadMesh,
-    local_rounds: u32,
-) -> (AdaptReport, Vec<EdgeCurve>) {
     let straight = q.vertices.clone();
-    adapt_rounds(dt, g, curves, m, net, q, &straight, local_rounds)
+    adapt_within(dt, g, curves, m, net, q, &straight, LOCAL_ROUNDS)
 }
 
-/// [`adapt_within`] given the straight template points (`q`'s vertices as [`QuadMesh::build`]
-/// placed them), for a caller that keeps them anyway.
+/// [`adapt`] given the straight template points (`straight`: `q`'s vertices as
+/// [`QuadMesh::build`] placed them, which a caller may keep anyway), with the damping near the
+/// poor elements limited to `local_rounds` rounds (the default is [`LOCAL_ROUNDS`]); from then
+/// on a poor element's G' edges are straightened whole. With 0, every G' edge a poor element
+/// needs damped is straightened at once: the bluntest repair, for comparison.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn adapt_rounds(
+pub fn adapt_within(
     dt: &RegionTriangulation,
     g: &CurveGraph,
     curves: &[CubicBezier],

@@ -201,7 +201,7 @@ pub fn remesh(
     let mut mesh = QuadMesh::build(&dt.triangulation, &elements, &net, options.level);
     let straight_vertices = mesh.vertices.clone();
     let templates = clock.elapsed().as_secs_f64() - triangulation - pairing;
-    let (adaptation, edge_curves) = adapt::adapt_rounds(
+    let (adaptation, edge_curves) = adapt_within(
         &dt,
         g,
         curves,

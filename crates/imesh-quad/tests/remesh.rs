@@ -297,7 +297,16 @@ fn straightening_whole_curves_is_the_blunt_fallback() {
         let mut mesh = QuadMesh::build(t, &r.elements, &net, 1);
         let straight = mesh.clone();
         let g = &c.simplified.graph;
-        let (report, pieces) = adapt_within(&r.dt, g, &fitted, &r.elements, &mut net, &mut mesh, 0);
+        let (report, pieces) = adapt_within(
+            &r.dt,
+            g,
+            &fitted,
+            &r.elements,
+            &mut net,
+            &mut mesh,
+            &straight.vertices,
+            0,
+        );
         assert_eq!(report.invalid_left, 0, "{name}");
         assert!(report.damped_curves > 0, "{name}");
         for x in 0..mesh.quads.len() {
