@@ -274,14 +274,7 @@ fn four_connected_components(labels: &[u32], w: usize, h: usize) -> Vec<u32> {
         comp[start] = next;
         stack.push(start);
         while let Some(i) = stack.pop() {
-            let (x, y) = (i % w, i / w);
-            let around = [
-                (x > 0).then(|| i - 1),
-                (x + 1 < w).then(|| i + 1),
-                (y > 0).then(|| i - w),
-                (y + 1 < h).then(|| i + w),
-            ];
-            for j in around.into_iter().flatten() {
+            for j in four_neighbours(i, w, h).into_iter().flatten() {
                 if comp[j] == u32::MAX && labels[j] == labels[i] {
                     comp[j] = next;
                     stack.push(j);
@@ -291,6 +284,17 @@ fn four_connected_components(labels: &[u32], w: usize, h: usize) -> Vec<u32> {
         next += 1;
     }
     comp
+}
+
+/// The 4-neighbours of pixel `i` of a `w × h` grid (left, right, up, down; `None` off the grid).
+pub(crate) fn four_neighbours(i: usize, w: usize, h: usize) -> [Option<usize>; 4] {
+    let (x, y) = (i % w, i / w);
+    [
+        (x > 0).then(|| i - 1),
+        (x + 1 < w).then(|| i + 1),
+        (y > 0).then(|| i - w),
+        (y + 1 < h).then(|| i + w),
+    ]
 }
 
 #[cfg(test)]

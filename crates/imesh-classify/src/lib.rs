@@ -9,7 +9,8 @@
 //! - k-means colour clustering in CIE Lab (k-means++, fixed seed);
 //! - the supervised texture classifier of Imesh ([`TextureClassifier`]).
 //!
-//! Clean-up: [`remove_small_regions`] and [`majority_filter`].
+//! Clean-up: [`remove_small_regions`], [`majority_filter`], and [`remove_border_slivers`] (the
+//! thin parts the majority filter leaves against the image's border).
 //!
 //! ```
 //! use imesh_classify::{classify, Classifier, ClassifyOptions};
@@ -35,6 +36,7 @@ mod kmeans;
 mod labels;
 mod load;
 mod reduce;
+mod slivers;
 mod spec;
 mod texture;
 mod threshold;
@@ -50,6 +52,7 @@ pub use kmeans::kmeans;
 pub use labels::{label_map, looks_like_label_map};
 pub use load::{decode_image, is_lossy_file, load_image, DEFAULT_MAX_PIXELS};
 pub use reduce::reduce;
+pub use slivers::{remove_border_slivers, MAX_SLIVER_HALF_WIDTH};
 pub use spec::Classifier;
 pub use texture::{SampleLabel, TextureClassifier, TextureSamples};
 pub use threshold::{luminance, multi_otsu_levels, threshold};

@@ -152,6 +152,22 @@ pub const LINK_SHARE: f64 = 0.5;
 /// half a quad can only be filled with quads of a fraction of the mean area.
 pub const AUTO_MIN_WIDTH: f64 = 0.5;
 
+/// After the majority filter, the parts of regions thinner than twice this share of its radius
+/// (the radius is about a quad side: half a quad, as [`AUTO_MIN_WIDTH`]) only because they lie
+/// against the image's border, each of at least a quad's area, are given to their neighbours
+/// ([`imesh_classify::remove_border_slivers`]). The filter's window is cut off at the border,
+/// and where a region nearly touches the border the gap tapering between them kept its pixels
+/// down to a cell's width, which the mesh filled with quads a few hundredths of the mean area.
+/// Measured with no options: scikit-image's `retina` (not a fixture; a fundus photograph
+/// whose disc comes within a few pixels of the frame, meshed on cells of 3 × 3 pixels) mean
+/// shape-and-size 0.883 → 0.938, worst 1.5e-5 → 0.003, label agreement 99.31 → 99.28 %; a disc
+/// 6 px from the side of a 1400² image 0.877 → 0.941 (worst scaled Jacobian 0.455 → 0.507); the
+/// ten fixtures and the thirteen other unseen images of session 42 identical to the byte. With
+/// parts down to `(2 · half-width)²` pixels instead of a quad's area, caps of nuclei a few
+/// pixels across at stardist's border and a 4-pixel bump at `moon`'s went too, and those meshes
+/// moved by the pipeline's usual path dependence (moon's mean 0.973 → 0.964 for 4 pixels).
+pub const BORDER_SLIVER: f64 = 0.25;
+
 /// Where simplification brings a vertex of G' closer than this many quad sides to an edge of
 /// G', the edge keeps the vertex of its chain nearest that vertex, if that one is
 /// [`imesh_curves::NECK_RATIO`] times farther ([`imesh_curves::neck_vertices`]).
@@ -322,8 +338,9 @@ pub struct MeshOptions {
     pub min_region: usize,
     /// Radius of a majority filter applied to the labels before meshing (0: none): every pixel
     /// takes the label most common in its (2R+1)² window, which removes specks, notches and
-    /// strips thinner than about R pixels. `None` (auto): about one quad side for a uniform
-    /// quad mesh ([`auto_majority`]), none for a graded one or triangles.
+    /// strips thinner than about R pixels; then the parts thinner than R / 2 against the image's
+    /// border ([`BORDER_SLIVER`]) go to their neighbours. `None` (auto): about one quad side for
+    /// a uniform quad mesh ([`auto_majority`]), none for a graded one or triangles.
     pub majority: Option<u32>,
     /// Mesh a reduced label grid whose every cell is the most frequent label of about
     /// `F × F` pixels ([`imesh_classify::reduce`]), then scale the mesh back onto the image:
@@ -1711,6 +1728,13 @@ impl Pipeline {
         let mut cleaned = grid.clone();
         if majority > 0 {
             cleaned = imesh_classify::majority_filter(&cleaned, majority, 1);
+            // Parts of at least a quad's area (the filter's radius is about a quad side): a
+            // smaller one holds a few small quads at most, and keeps its pixels.
+            cleaned = imesh_classify::remove_border_slivers(
+                &cleaned,
+                BORDER_SLIVER * f64::from(majority),
+                (majority * majority) as usize,
+            );
         }
         if o.min_region > 1 {
             cleaned = imesh_classify::remove_small_regions(&cleaned, o.min_region);
