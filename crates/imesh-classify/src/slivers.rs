@@ -75,7 +75,8 @@ fn pinched_by_border(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
             .then(|| y as usize * w + x as usize)
     };
     // Per disk centre (on a grid padded by `reach` on every side), computed once: one label
-    // throughout the disk's pixels in the image, and the disk wholly inside the image.
+    // throughout the disk's pixels in the image, and the disk wholly inside the image. A
+    // centre is only asked about for a pixel its disk holds, so the disk is never all outside.
     const KNOWN: u8 = 1;
     const ONE_LABEL: u8 = 2;
     const INSIDE: u8 = 4;
