@@ -143,12 +143,11 @@ pub fn pixel_regions(grid: &LabelGrid) -> Vec<PixelRegion> {
         let r = &mut regions[c as usize];
         r.label = grid.labels()[i];
         r.pixels += 1;
-        let (x, y) = (i % w, i / w);
-        let differs = |j: Option<usize>| j.is_none_or(|j| comp[j] != c);
-        r.perimeter += usize::from(differs((x > 0).then(|| i - 1)))
-            + usize::from(differs((x + 1 < w).then(|| i + 1)))
-            + usize::from(differs((y > 0).then(|| i - w)))
-            + usize::from(differs((y + 1 < h).then(|| i + w)));
+        // A side on the image's border or against another region.
+        r.perimeter += four_neighbours(i, w, h)
+            .into_iter()
+            .filter(|j| j.is_none_or(|j| comp[j] != c))
+            .count();
     }
     regions
 }
