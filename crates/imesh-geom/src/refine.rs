@@ -549,6 +549,55 @@ impl Triangulation {
         Ok(self.points.len() - before)
     }
 
+    /// Splits the constrained edge from `u` to `w` at `p` (projected onto its input segment's
+    /// line, so that the segment stays straight), and returns the new vertex; `None` (nothing
+    /// done) when `u w` is not a constrained edge or `p` does not lie strictly between its ends.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, Triangulation};
+    /// let pts = [Point::new(0.0, 0.0), Point::new(0.0, 9.0), Point::new(4.0, 3.0)];
+    /// let (mut t, v) = Triangulation::from_points(&pts).unwrap();
+    /// let s = t.insert_segment(v[0], v[1]).unwrap();
+    /// // Peeled off from the front: each split leaves the rest of the piece to the next one.
+    /// let a = t.split_piece_at(v[0], v[1], Point::new(0.0, 3.0)).unwrap().unwrap();
+    /// let b = t.split_piece_at(a, v[1], Point::new(0.0, 7.5)).unwrap().unwrap();
+    /// assert_eq!(t.segment_vertices(s), vec![v[0], a, b, v[1]]);
+    /// // Not a constrained edge (the piece is gone), or not inside the piece: nothing to split.
+    /// assert_eq!(t.split_piece_at(v[0], v[1], Point::new(0.0, 5.0)).unwrap(), None);
+    /// assert_eq!(t.split_piece_at(a, b, Point::new(0.0, 2.0)).unwrap(), None);
+    /// t.check().unwrap();
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Triangulation::split_long_segments`].
+    pub fn split_piece_at(
+        &mut self,
+        u: VertexId,
+        w: VertexId,
+        p: Point,
+    ) -> Result<Option<VertexId>, GeomError> {
+        let Some(h) = self.find_edge(u, w).filter(|&h| self.is_constrained(h)) else {
+            return Ok(None);
+        };
+        // Along the piece, and clear of its ends by more than the snapping can move it.
+        let (pu, pw) = (self.points[u.index()], self.points[w.index()]);
+        let d = pw - pu;
+        let f = ((p.x - pu.x) * d.x + (p.y - pu.y) * d.y) / (d.x * d.x + d.y * d.y);
+        if !(f > 1e-9 && f < 1.0 - 1e-9) {
+            return Ok(None);
+        }
+        // A point exactly on the line (an axis-parallel segment's) stays as it is.
+        let [a, b] =
+            self.segments[self.segment[h.0 as usize] as usize].map(|x| self.points[x as usize]);
+        let p = if crate::predicates::orient2d(a, b, p) == 0.0 {
+            p
+        } else {
+            self.snap_to_segment(h.0, p)
+        };
+        let v = self.insert_on_edge(h.0, p)?;
+        Ok((v != u && v != w).then_some(v))
+    }
+
     /// Splits the constrained edge from `u` to `w` into `pieces` equal parts.
     fn split_piece(&mut self, u: u32, w: u32, pieces: usize) -> Result<(), GeomError> {
         let pw = self.points[w as usize];
