@@ -587,9 +587,8 @@ impl Triangulation {
             return Ok(None);
         }
         // A point exactly on the line (an axis-parallel segment's) stays as it is.
-        let [a, b] =
-            self.segments[self.segment[h.0 as usize] as usize].map(|x| self.points[x as usize]);
-        let p = if crate::predicates::orient2d(a, b, p) == 0.0 {
+        let [a, b] = self.segment_line(h.0);
+        let p = if orient2d(a, b, p) == 0.0 {
             p
         } else {
             self.snap_to_segment(h.0, p)
@@ -800,14 +799,18 @@ impl Triangulation {
         }
     }
 
+    /// The ends of the input segment the constrained half-edge `h` lies on.
+    fn segment_line(&self, h: u32) -> [Point; 2] {
+        self.segments[self.segment[h as usize] as usize].map(|v| self.points[v as usize])
+    }
+
     /// `p` (a split point of the constrained edge of `h`) moved onto the exact line of its input
     /// segment when possible: its parameter along the segment, rounded to a multiple of 2^-36, gives
     /// an exactly representable point on the line whenever the segment's ends lie on a coarse
     /// lattice (pixel corners and centres). Split points computed from Steiner ends would drift off
     /// the line by rounding; on the hull that drift changes the hull.
     fn snap_to_segment(&self, h: u32, p: Point) -> Point {
-        let [a, b] =
-            self.segments[self.segment[h as usize] as usize].map(|v| self.points[v as usize]);
+        let [a, b] = self.segment_line(h);
         let d = b - a;
         let f = ((p.x - a.x) * d.x + (p.y - a.y) * d.y) / (d.x * d.x + d.y * d.y);
         let scale = 2f64.powi(36);

@@ -10,7 +10,7 @@
 //! refinement.
 
 use imesh_curves::{segment_distance, SegmentIndex};
-use imesh_geom::{GeomError, Location, Point, Triangulation, VertexId, EXTERIOR};
+use imesh_geom::{GeomError, HalfEdgeId, Location, Point, Triangulation, VertexId, EXTERIOR};
 
 /// How narrow a strip between two boundaries is, in spacings, for its boundary pieces to be
 /// cut to its depth ([`uniform_points`], step 2). A strip narrower than about twice the
@@ -131,11 +131,8 @@ pub fn uniform_points_with_lattice(
             }
         });
         // Only on the hull itself: a domain that is not the full rectangle keeps its shape.
-        let on_hull = match t.locate(p) {
-            Location::OnEdge(h) => t.neighbour(h).is_none() || t.neighbour(t.twin(h)).is_none(),
-            _ => false,
-        };
-        if clear && on_hull {
+        let on_border = matches!(t.locate(p), Location::OnEdge(h) if on_hull(t, h));
+        if clear && on_border {
             border.push(p);
         }
     }
@@ -182,9 +179,10 @@ pub fn uniform_points_with_lattice(
 /// pieces instead, its band was left to refinement, whose triangles pair into skewed quads
 /// and leave unpaired ones: stripes 40 px wide at quads of 3.6 px scored a mean
 /// shape-and-size of 0.857 with a worst scaled Jacobian of 0.509 and 542 unpaired triangles,
-/// against 0.865, 1 (every quad a rectangle) and none. Over 45 images (the fixtures but aloe,
+/// against 0.865, 1 (every quad a rectangle) and none. Over 42 images (the fixtures but aloe,
 /// unseen photographs and label maps, synthetic rectangles, grains and stripes) the mean rose
-/// on 16 and fell on 8; only pieces exactly along an axis count: taking those within 5° too
+/// on 16 and fell on 6 (docs/measurements.md, session 45); only pieces exactly along an axis
+/// count: taking those within 5° too
 /// (simplification tilts a pixel edge's boundary by a pixel or so) made the band's cells
 /// 0.6–1.6 spacings wide with their lattice line kept or dropped along a piece, and
 /// scikit-image's checkerboard fell 0.863 → 0.820.
@@ -195,10 +193,7 @@ fn axis_crossings(
 ) -> Vec<(VertexId, VertexId, Vec<Point>)> {
     let grid = EdgeGrid::new(t, reach);
     let mut crossings = Vec::new();
-    for h in t.constrained_edges() {
-        if t.neighbour(h).is_none() || t.neighbour(t.twin(h)).is_none() {
-            continue;
-        }
+    for h in t.constrained_edges().filter(|&h| !on_hull(t, h)) {
         let (u, w) = (t.origin(h), t.destination(h));
         let (pu, pw) = (t.point(u), t.point(w));
         // Along a column (x fixed) the rows cross it, along a row the columns.
@@ -242,6 +237,11 @@ fn axis_crossings(
         }
     }
     crossings
+}
+
+/// True when the edge of half-edge `h` is on the hull (a ghost triangle on one side).
+fn on_hull(t: &Triangulation, h: HalfEdgeId) -> bool {
+    t.neighbour(h).is_none() || t.neighbour(t.twin(h)).is_none()
 }
 
 /// True when `p` lies in the domain: inside the hull, and not in a triangle labelled
