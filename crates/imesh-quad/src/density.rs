@@ -45,7 +45,7 @@ pub const BOUNDARY_PIECE: f64 = 1.5;
 /// 1. the lattice points on the hull that are clear of every other boundary (they split the
 ///    border segments, so that the lattice meets the border square on), and likewise the
 ///    points where the lattice lines cross an axis-parallel boundary inside
-///    ([`axis_crossings`]);
+///    (split with [`Triangulation::split_piece_at`]);
 /// 2. equal splits of every segment piece along a strip narrower than [`STRIP`] spacings
 ///    into pieces about as long as the strip is deep, then of every piece still longer than
 ///    [`BOUNDARY_PIECE`] spacings;
