@@ -10,7 +10,7 @@
 //! refinement.
 
 use imesh_curves::{segment_distance, SegmentIndex};
-use imesh_geom::{GeomError, HalfEdgeId, Location, Point, Triangulation, VertexId, EXTERIOR};
+use imesh_geom::{GeomError, Location, Point, Triangulation, VertexId, EXTERIOR};
 
 /// How narrow a strip between two boundaries is, in spacings, for its boundary pieces to be
 /// cut to its depth ([`uniform_points`], step 2). A strip narrower than about twice the
@@ -42,10 +42,9 @@ pub const BOUNDARY_PIECE: f64 = 1.5;
 /// segments are the boundaries, its hull usually an axis-aligned rectangle), and returns how
 /// many were inserted:
 ///
-/// 1. the lattice points on the hull that are clear of every other boundary (they split the
-///    border segments, so that the lattice meets the border square on), and likewise the
-///    points where the lattice lines cross an axis-parallel boundary inside
-///    (split with [`Triangulation::split_piece_at`]);
+/// 1. the points where the lattice lines cross an axis-parallel boundary piece (the border's
+///    and those inside) that are clear of every other piece, so that the lattice meets them
+///    square on (split with [`Triangulation::split_piece_at`]);
 /// 2. equal splits of every segment piece along a strip narrower than [`STRIP`] spacings
 ///    into pieces about as long as the strip is deep, then of every piece still longer than
 ///    [`BOUNDARY_PIECE`] spacings;
@@ -113,32 +112,7 @@ pub fn uniform_points_with_lattice(
     let lattice = Lattice::new(t, spacing);
     let reach = CLEARANCE * spacing;
 
-    // 1. The border.
-    let grid = EdgeGrid::new(t, reach);
-    let mut border = Vec::new();
-    for (i, j) in lattice.border() {
-        let p = lattice.point(i, j);
-        let clear = grid.clear(p, reach, |[a, b]| {
-            // A piece of the same border side counts by its ends only: the point lies on it.
-            let side = |q: Point| {
-                (q.x == p.x && (p.x == lattice.lo.x || p.x == lattice.hi.x))
-                    || (q.y == p.y && (p.y == lattice.lo.y || p.y == lattice.hi.y))
-            };
-            if side(a) && side(b) {
-                a.distance_squared(p).min(b.distance_squared(p)).sqrt()
-            } else {
-                segment_distance(a, b, p)
-            }
-        });
-        // Only on the hull itself: a domain that is not the full rectangle keeps its shape.
-        let on_border = matches!(t.locate(p), Location::OnEdge(h) if on_hull(t, h));
-        if clear && on_border {
-            border.push(p);
-        }
-    }
-    for p in border {
-        t.insert(p)?;
-    }
+    // 1. The border and the axis-parallel boundaries.
     for (u, w, points) in axis_crossings(t, &lattice, reach) {
         let mut at = u;
         for p in points {
@@ -168,15 +142,15 @@ pub fn uniform_points_with_lattice(
     Ok(t.num_vertices() - before)
 }
 
-/// The points where the lattice lines cross the axis-parallel boundary pieces inside the
-/// domain (not on the hull) and that are `reach` clear of every other piece: per piece `u w`,
-/// its crossings in order from `u`, so that each lies on what the previous split left of it
-/// ([`Triangulation::split_piece_at`]).
+/// The points where the lattice lines cross the axis-parallel boundary pieces (the border's,
+/// and those inside the domain) and that are `reach` clear of every other piece: per piece
+/// `u w`, its crossings in order from `u`, so that each lies on what the previous split left
+/// of it ([`Triangulation::split_piece_at`]).
 ///
-/// The border gets the lattice's points for the same reason: a boundary along a lattice row
-/// or column, cut where the lattice lines cross it, makes rectangles with the lattice points
-/// beside it, which pairing joins into quads whose every corner is square. Cut into equal
-/// pieces instead, its band was left to refinement, whose triangles pair into skewed quads
+/// A boundary along a lattice row or column, cut where the lattice lines cross it, makes
+/// rectangles with the lattice points beside it, which pairing joins into quads whose every
+/// corner is square. The border always was; an axis-parallel boundary inside was cut into
+/// equal pieces instead (until session 45), and its band was left to refinement, whose triangles pair into skewed quads
 /// and leave unpaired ones: stripes 40 px wide at quads of 3.6 px scored a mean
 /// shape-and-size of 0.857 with a worst scaled Jacobian of 0.509 and 542 unpaired triangles,
 /// against 0.865, 1 (every quad a rectangle) and none. Over 42 images (the fixtures but aloe,
@@ -193,7 +167,7 @@ fn axis_crossings(
 ) -> Vec<(VertexId, VertexId, Vec<Point>)> {
     let grid = EdgeGrid::new(t, reach);
     let mut crossings = Vec::new();
-    for h in t.constrained_edges().filter(|&h| !on_hull(t, h)) {
+    for h in t.constrained_edges() {
         let (u, w) = (t.origin(h), t.destination(h));
         let (pu, pw) = (t.point(u), t.point(w));
         // Along a column (x fixed) the rows cross it, along a row the columns.
@@ -237,11 +211,6 @@ fn axis_crossings(
         }
     }
     crossings
-}
-
-/// True when the edge of half-edge `h` is on the hull (a ghost triangle on one side).
-fn on_hull(t: &Triangulation, h: HalfEdgeId) -> bool {
-    t.neighbour(h).is_none() || t.neighbour(t.twin(h)).is_none()
 }
 
 /// True when `p` lies in the domain: inside the hull, and not in a triangle labelled
@@ -320,14 +289,6 @@ impl Lattice {
         } else {
             self.point(0, k).y
         }
-    }
-
-    /// The lattice points on the border, corners excepted.
-    fn border(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        let [nx, ny] = self.n;
-        let rows = (1..nx).flat_map(move |i| [(i, 0), (i, ny)]);
-        let columns = (1..ny).flat_map(move |j| [(0, j), (nx, j)]);
-        rows.chain(columns)
     }
 }
 
