@@ -11,9 +11,10 @@
 //! A tip one of whose sides ends before it is a quad side wide (the region turns away there)
 //! is cut from that side's far vertex instead: its height over the other side is under a
 //! quad side, so a cut a quad side long meets the other side beyond its foot, at an angle
-//! of 30° or more for the neighbour and 150° or less for the region; a tip both of whose
-//! sides end that early, between their ends; and a spike that stays narrow one vertex further
-//! (a pixel staircase), from that vertex.
+//! of 30° or more for the neighbour and 150° or less for the region (where it ends too low
+//! over the other side for that, the end of a sliver, square from its end to the other side);
+//! a tip both of whose sides end that early, between their ends; and a spike that stays
+//! narrow one vertex further (a pixel staircase), from that vertex.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -27,6 +28,11 @@ const OUTSIDE: u32 = u32::MAX;
 
 /// The widths a tip is cut at, in [`TipOptions::width`]s: the widest its edges leave room for.
 const WIDTHS: [f64; 3] = [2.0, 1.5, 1.0];
+
+/// The lowest a side's far vertex may stand over the other side, in [`TipOptions::width`]s,
+/// for a square cut from it (see [`through_depth`]): a lower one would make an edge, and
+/// elements, a tenth of a quad side.
+const SQUARE_CUT_MIN_HEIGHT: f64 = 0.1;
 
 /// Options of [`blunt_sharp_tips`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,7 +191,8 @@ impl Tip {
 /// The curves are cut at the new vertices' projections, their ends moved onto them. Where one
 /// edge is too short for that (the region turns away at its far vertex), the cut runs from
 /// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
-/// `options.min_angle_deg` or more, the short edge going to the receiver whole; where both
+/// `options.min_angle_deg` or more (or square to it, where the far vertex stands too low over
+/// it for that: the end of a sliver), the short edge going to the receiver whole; where both
 /// are, between their far vertices if those are a width or more apart; failing those, the
 /// same from the next vertex along the region's boundary on either side (a staircase spike),
 /// the cut then at most two widths long. A sector is left alone when no cut fits, when an
@@ -569,8 +576,16 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
 /// for the tip at `p` (the region on the left of `long`, or on its right when `right`): the
 /// widest of [`WIDTHS`] for which the cut meets `long` at [`TipOptions::min_angle_deg`] or
 /// more beyond the foot of `q` (so that the region keeps at least 90° there), within `long`
-/// (leaving half a width of it) and within [`TipOptions::max_depth`] widths of `p`. `None`
-/// when no width fits, or when `q` is not on the region's side of `long`.
+/// (leaving half a width of it) and within [`TipOptions::max_depth`] widths of `p`.
+///
+/// Where no width fits and `q` stands less than a width over `long` (under half a width, a
+/// cut a width long meets `long` at under 30°), the tip is the end of a sliver thinner than a
+/// quad: a thin region along the image's border whose end the label clean-up has bevelled, a
+/// grain boundary grazing the border. It is then cut square, from `q` to its foot, if that
+/// lies within the same bounds: both regions get 90° there, and the sliver's end is as wide
+/// as the sliver, whose quads are that small anyway, where the tip left whole would hold a
+/// quad with the tip's angle (under 0.5 in scaled Jacobian). `None` when no cut fits, or when
+/// `q` is not on the region's side of `long`.
 fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptions) -> Option<f64> {
     let along = (long.far - p) * (1.0 / norm(long.far - p));
     // `q`'s foot on `long`'s line, and its height over it on the region's side.
@@ -581,15 +596,26 @@ fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptio
         return None;
     }
     let min = options.min_angle_deg.to_radians();
-    WIDTHS.iter().map(|&k| k * options.width).find_map(|w| {
-        let run = (w * w - height * height).sqrt();
-        let depth = foot + run;
-        (w >= height
-            && height.atan2(run) >= min
-            && depth <= norm(long.far - p) - 0.5 * options.width
-            && depth <= options.max_depth * w)
-            .then_some(depth)
-    })
+    WIDTHS
+        .iter()
+        .map(|&k| k * options.width)
+        .find_map(|w| {
+            let run = (w * w - height * height).sqrt();
+            let depth = foot + run;
+            (w >= height
+                && height.atan2(run) >= min
+                && depth <= norm(long.far - p) - 0.5 * options.width
+                && depth <= options.max_depth * w)
+                .then_some(depth)
+        })
+        .or_else(|| {
+            (height < options.width
+                && height >= SQUARE_CUT_MIN_HEIGHT * options.width
+                && foot > 0.0
+                && foot <= norm(long.far - p) - 0.5 * options.width
+                && foot <= options.max_depth * options.width)
+                .then_some(foot)
+        })
 }
 
 /// `edge` whole, relabelled with the receiver for the region of `tip`, when it still
@@ -1038,6 +1064,47 @@ mod tests {
         let run = 3.0 * 20f64.to_radians().cos()
             + (4.0 - (3.0 * 20f64.to_radians().sin()).powi(2)).sqrt();
         assert!((b.area - 0.5 * 3.0 * run * 20f64.to_radians().sin()).abs() < 1e-9);
+    }
+
+    /// A 12° tip whose upper side ends 2.45 px over the lower one (where the region turns up):
+    /// a cut a width (6 px) long from there would meet the lower side at 24°, so the tip is cut
+    /// square, from that side's end straight down to the lower side. Before, the cut between
+    /// the sides' far vertices was sharp itself, and the tip was left whole.
+    #[test]
+    fn a_sliver_tip_is_cut_square_from_its_short_side() {
+        let (angle, short) = (12.0f64, 11.8);
+        let g = hook(angle, short, 30.0, 35.0).unwrap();
+        let options = TipOptions {
+            width: 6.0,
+            reach: 6.0,
+            ..TipOptions::default()
+        };
+        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        let cut = b.graph.edges().last().unwrap();
+        let new = g.points().len() as u32;
+        assert!(cut.ends.contains(&4) && cut.ends.contains(&new));
+        // Square to the lower side (vertex 0 to vertex 1), as long as the side's end is high.
+        let [p, q] = cut.ends.map(|v| b.graph.point(v));
+        let lower = g.point(1) - g.point(0);
+        assert!(dot(q - p, lower).abs() < 1e-9 * norm(lower));
+        let height = short * angle.to_radians().sin();
+        assert!((norm(q - p) - height).abs() < 1e-9);
+        // Region 1 keeps a right angle at the cut's foot; region 0, which takes the tip and
+        // the lower side up to there, the rest.
+        let sectors = sectors_at(&b.graph, new);
+        assert_eq!(sectors.len(), 2);
+        for (label, sector) in sectors {
+            let expected = if label == 1 { 90.0 } else { 270.0 };
+            assert!((sector - expected).abs() < 1e-6, "{label}: {sector}");
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
+        let foot = short * angle.to_radians().cos();
+        assert!((b.area - 0.5 * foot * height).abs() < 1e-9);
     }
 
     /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
