@@ -126,6 +126,15 @@ pub fn contract_short_links(
             | u8::from(p.y == 0.0) << 2
             | u8::from(p.y == height) << 3
     };
+    // The polylines ending at each vertex: a contraction's loops are found among those of the
+    // smaller of the two merged classes, not by a pass over every polyline (the contractions
+    // times the polylines made a photo read as a label map take half a minute).
+    let mut lines_at: Vec<Vec<usize>> = vec![Vec::new(); g.points().len()];
+    for (j, line) in lines.iter().enumerate() {
+        for v in line.ends() {
+            lines_at[v as usize].push(j);
+        }
+    }
     let mut refused: HashSet<usize> = HashSet::new();
     loop {
         // Union of merged vertices: `rep[v]` leads to the survivor, which holds the position.
@@ -141,6 +150,8 @@ pub fn contract_short_links(
         let mut pinned: Vec<bool> = (0..points.len() as u32).map(|v| g.is_pinned(v)).collect();
         let mut gone = vec![false; g.edges().len()];
         let mut made: Vec<(usize, u32)> = Vec::new();
+        // The vertices merged into each survivor (itself included).
+        let mut members: Vec<Vec<u32>> = (0..points.len() as u32).map(|v| vec![v]).collect();
         for &(_, k) in &candidates {
             if refused.contains(&k) {
                 continue;
@@ -153,14 +164,22 @@ pub fn contract_short_links(
             // Another polyline joining the same two junctions becomes a loop: it is cut at
             // its thirds (as `polylines` cuts a closed curve), and needs three edges for that.
             let mut loops = Vec::new();
-            for (j, line) in lines.iter().enumerate() {
-                if j == k || line.edges.iter().all(|&e| gone[e as usize]) {
-                    continue;
-                }
-                let [a, b] = line.ends();
-                let (ra, rb) = (find(&mut rep, a), find(&mut rep, b));
-                if (ra == ru && rb == rw) || (ra == rw && rb == ru) {
-                    loops.push(j);
+            let smaller = if members[ru as usize].len() <= members[rw as usize].len() {
+                ru
+            } else {
+                rw
+            };
+            for &m in &members[smaller as usize] {
+                for &j in &lines_at[m as usize] {
+                    let line = &lines[j];
+                    if j == k || line.edges.iter().all(|&e| gone[e as usize]) {
+                        continue;
+                    }
+                    let [a, b] = line.ends();
+                    let (ra, rb) = (find(&mut rep, a), find(&mut rep, b));
+                    if (ra == ru && rb == rw) || (ra == rw && rb == ru) {
+                        loops.push(j);
+                    }
                 }
             }
             if loops.iter().any(|&j| lines[j].edges.len() < 3) {
@@ -184,6 +203,8 @@ pub fn contract_short_links(
             };
             let Some(target) = target else { continue };
             rep[rw as usize] = ru;
+            let merged = std::mem::take(&mut members[rw as usize]);
+            members[ru as usize].extend(merged);
             points[ru as usize] = target;
             pinned[ru as usize] |= pinned[rw as usize];
             for &e in &lines[k].edges {

@@ -154,7 +154,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         // strips alone). Gravel's, 0.484 once its tips were cut (0.459 at a 27° corner
         // before), a quad of a strip 1.5 px wide along the border, under its 29.6° corner, is
         // at 0.5 since its neighbourhood moves as a whole (below); grass's, 0.485 once its tips with a short side are cut from that side's end (0.447
-        // at a 27° corner before), a quad of a gap 1.4 px wide between two regions.
+        // at a 27° corner before), a quad of a gap 1.4 px wide between two regions; aloe's,
+        // 0.361 since junctions three quarters of a quad apart are merged (0.352 at a 20.7°
+        // corner before; its sharpest is now 23.9°), a quad of its tangles of pixel-wide
+        // regions.
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -235,7 +238,7 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         );
         assert!(t.sharpest_boundary_corner.is_none());
     }
-    assert!(at_a_bound >= 9, "{at_a_bound}");
+    assert!(at_a_bound >= 8, "{at_a_bound}");
 }
 
 /// A uniform size (`--size`) lifts shape-and-size well above the graded DT' on a fixture, and
