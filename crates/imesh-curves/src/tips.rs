@@ -596,25 +596,24 @@ fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptio
         return None;
     }
     let min = options.min_angle_deg.to_radians();
+    // Within `long` (half a width short of its end) and `max_depth` cut widths of `p`.
+    let within = |depth: f64, w: f64| {
+        depth <= norm(long.far - p) - 0.5 * options.width && depth <= options.max_depth * w
+    };
     WIDTHS
         .iter()
         .map(|&k| k * options.width)
         .find_map(|w| {
             let run = (w * w - height * height).sqrt();
             let depth = foot + run;
-            (w >= height
-                && height.atan2(run) >= min
-                && depth <= norm(long.far - p) - 0.5 * options.width
-                && depth <= options.max_depth * w)
-                .then_some(depth)
+            (w >= height && height.atan2(run) >= min && within(depth, w)).then_some(depth)
         })
         .or_else(|| {
             (height < options.width
                 && height >= SQUARE_CUT_MIN_HEIGHT * options.width
                 && foot > 0.0
-                && foot <= norm(long.far - p) - 0.5 * options.width
-                && foot <= options.max_depth * options.width)
-                .then_some(foot)
+                && within(foot, options.width))
+            .then_some(foot)
         })
 }
 
