@@ -34,6 +34,10 @@ const WIDTHS: [f64; 3] = [2.0, 1.5, 1.0];
 /// elements, a tenth of a quad side.
 const SQUARE_CUT_MIN_HEIGHT: f64 = 0.1;
 
+/// Twice the largest area, in squared [`TipOptions::width`]s, of a tip cut between its sides'
+/// ends when those are less than a width apart: a sliver's end, a quarter of a quad.
+const SMALL_PIECE: f64 = 0.5;
+
 /// Options of [`blunt_sharp_tips`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TipOptions {
@@ -47,7 +51,8 @@ pub struct TipOptions {
     /// curves'.
     pub reach: f64,
     /// The deepest cut, in widths from the vertex: a sharper tip is cut there, narrower than
-    /// `width`, which still leaves right-ish corners.
+    /// `width`, which still leaves right-ish corners. A sliver's end cut square may lie
+    /// deeper when its piece is no larger (see `blunt_sharp_tips`).
     pub max_depth: f64,
 }
 
@@ -195,9 +200,13 @@ impl Tip {
 /// it for that: the end of a sliver), the short edge going to the receiver whole; where both
 /// are, between their far vertices if those are a width or more apart; failing those, the
 /// same from the next vertex along the region's boundary on either side (a staircase spike),
-/// the cut then at most two widths long. A sector is left alone when no cut fits, when an
-/// edge is already cut at its other end, or when a vertex of the graph lies in the piece cut
-/// off; cuts whose edges would cross are dropped. `None` when nothing was cut.
+/// the cut then at most two widths long; failing all those, between the first vertices even
+/// when they are closer than a width, if the piece is a quarter of a quad or less (a sliver's
+/// end). The first of these cuts whose piece holds no other vertex of the graph is made; a
+/// sector is left alone when none does. Cuts whose edges would cross are dropped, and so are
+/// cuts whose new corners would be sharp (that tip is not tried again). An edge is cut at one
+/// end per round, the sharper tip's first: a tip whose edge was taken is looked at again on
+/// the graph the round leaves, for up to four rounds. `None` when nothing was cut.
 ///
 /// ```
 /// use imesh_curves::{blunt_sharp_tips, CubicBezier, CurveGraph, GraphEdge, TipOptions};
@@ -234,19 +243,64 @@ pub fn blunt_sharp_tips(
     if curves.len() != g.edges().len() || !(options.width > 0.0 && options.width.is_finite()) {
         return None;
     }
+    // An edge is cut at one end per round: a tip whose edge a sharper one took is looked at
+    // again on the graph that cut leaves (a long edge between two sharp tips, a sliver along
+    // the border between two junctions).
+    let mut blunted: Option<Blunted> = None;
+    // The vertices of tips whose cut was dropped for sharp new corners: not tried again, so
+    // that the tips it kept from their edges are cut in the next round.
+    let mut refused = Vec::new();
+    for _ in 0..MAX_ROUNDS {
+        let (graph, curves) = match &blunted {
+            Some(b) => (&b.graph, b.curves.as_slice()),
+            None => (g, curves),
+        };
+        let Some((round, deferred)) = blunt_round(graph, curves, options, &mut refused) else {
+            break;
+        };
+        blunted = Some(match blunted {
+            Some(b) => Blunted {
+                tips: b.tips + round.tips,
+                area: b.area + round.area,
+                moved: b.moved.max(round.moved),
+                ..round
+            },
+            None => round,
+        });
+        if !deferred {
+            break;
+        }
+    }
+    blunted
+}
+
+/// The rounds of [`blunt_sharp_tips`] at most: each cuts at least one tip, and the tips left
+/// for a later round share an edge with one cut.
+const MAX_ROUNDS: usize = 4;
+
+/// One round of [`blunt_sharp_tips`]: the graph with every tip cut whose edges no sharper
+/// tip's cut takes, and whether a tip was left for that reason. Tips at the points in
+/// `refused` are left; those whose cut is dropped for sharp new corners are added to it.
+/// `None` when nothing was cut.
+fn blunt_round(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    options: &TipOptions,
+    refused: &mut Vec<Point>,
+) -> Option<(Blunted, bool)> {
     let mut tips = sharp_tips(g, curves, options);
+    tips.retain(|tip| !refused.contains(&g.point(tip.vertex)));
     // The sharpest first; an edge is cut at one end only.
     tips.sort_by(|a, b| a.angle.total_cmp(&b.angle));
     let mut used = vec![false; g.edges().len()];
     let mut cuts = Vec::new();
+    let mut deferred = false;
     for tip in tips {
         if tip.edges().any(|e| used[e as usize]) {
+            deferred = true;
             continue;
         }
-        let (outline, [i, j], on) = tip.piece(g);
-        if !sound_piece(g, &on, &outline, [i, j]) {
-            continue;
-        }
+        let (outline, [i, j], _) = tip.piece(g);
         for e in tip.edges() {
             used[e as usize] = true;
         }
@@ -285,9 +339,10 @@ pub fn blunt_sharp_tips(
             })
             .collect();
         if sharp.is_empty() {
-            return Some(blunted);
+            return Some((blunted, deferred));
         }
         for &i in sharp.iter().rev() {
+            refused.push(g.point(cuts[i].tip.vertex));
             cuts.remove(i);
         }
     }
@@ -529,8 +584,12 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             };
             // Both too short: between the vertices where the sides end, if they are a width
             // or more apart (and at most two beyond the tip's first vertices), within the
-            // deepest cut, and not already joined by an edge.
-            let whole = |at: [CutEnd; 2]| {
+            // deepest cut, and not already joined by an edge. Failing every other cut, the
+            // first vertices closer than that too, when the piece is a sliver's end of at
+            // most a quarter of a quad (`across · depth ≤ SMALL_PIECE · width²`): a notch a
+            // fraction of a pixel wide that Imesh's sampling left.
+            let small = SMALL_PIECE * options.width * options.width;
+            let whole = |at: [CutEnd; 2], sliver: bool| {
                 let (qa, qb) = (far(0, at[0])?, far(1, at[1])?);
                 let across = norm(qb - qa);
                 let depth = cross(qa - p, qb - p).abs() / across;
@@ -539,7 +598,7 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
                     _ => ends[k].far_vertex,
                 });
                 let first = at == [CutEnd::First; 2];
-                (across >= options.width
+                ((across >= options.width || (sliver && first && across * depth <= small))
                     && (first || across <= WIDTHS[0] * options.width)
                     && depth <= options.max_depth * options.width
                     && !g
@@ -549,23 +608,31 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
                 .then_some(at)
             };
             let (first, second) = (CutEnd::First, CutEnd::Second);
-            let cut = across()
-                .or_else(|| through(first))
-                .or_else(|| whole([first; 2]))
-                .or_else(|| through(second))
-                .or_else(|| whole([second, first]))
-                .or_else(|| whole([first, second]))
-                .or_else(|| whole([second; 2]));
-            if let Some(cut) = cut {
-                tips.push(Tip {
-                    vertex: v,
-                    ends,
-                    next,
-                    region,
-                    receiver,
-                    angle,
-                    cut,
-                });
+            // The first of these whose piece holds no other vertex of the graph.
+            let candidates = [
+                across(),
+                through(first),
+                whole([first; 2], false),
+                through(second),
+                whole([second, first], false),
+                whole([first, second], false),
+                whole([second; 2], false),
+                whole([first; 2], true),
+            ];
+            let tip = |cut| Tip {
+                vertex: v,
+                ends,
+                next,
+                region,
+                receiver,
+                angle,
+                cut,
+            };
+            if let Some(tip) = candidates.into_iter().flatten().map(tip).find(|tip| {
+                let (outline, [i, j], on) = tip.piece(g);
+                sound_piece(g, &on, &outline, [i, j])
+            }) {
+                tips.push(tip);
             }
         }
     }
@@ -582,10 +649,13 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
 /// cut a width long meets `long` at under 30°), the tip is the end of a sliver thinner than a
 /// quad: a thin region along the image's border whose end the label clean-up has bevelled, a
 /// grain boundary grazing the border. It is then cut square, from `q` to its foot, if that
-/// lies within the same bounds: both regions get 90° there, and the sliver's end is as wide
-/// as the sliver, whose quads are that small anyway, where the tip left whole would hold a
-/// quad with the tip's angle (under 0.5 in scaled Jacobian). `None` when no cut fits, or when
-/// `q` is not on the region's side of `long`.
+/// lies within `long` and the piece cut off is no larger than the deepest width cut's
+/// (`foot · height ≤ max_depth · width²`, however deep: a long sliver under a pixel thick,
+/// which Imesh's sampling can leave across a narrow gap, is cut at its end): both regions
+/// get 90° there, and the sliver's end is as wide as the sliver, whose quads are that small
+/// anyway, where the tip left whole would hold a quad with the tip's angle (under 0.5 in
+/// scaled Jacobian). `None` when no cut fits, or when `q` is not on the region's side of
+/// `long`.
 fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptions) -> Option<f64> {
     let along = (long.far - p) * (1.0 / norm(long.far - p));
     // `q`'s foot on `long`'s line, and its height over it on the region's side.
@@ -596,24 +666,27 @@ fn through_depth(p: Point, q: Point, long: &End, right: bool, options: &TipOptio
         return None;
     }
     let min = options.min_angle_deg.to_radians();
-    // Within `long` (half a width short of its end) and `max_depth` cut widths of `p`.
-    let within = |depth: f64, w: f64| {
-        depth <= norm(long.far - p) - 0.5 * options.width && depth <= options.max_depth * w
-    };
+    // Within `long`, half a width short of its end.
+    let on_long = |depth: f64| depth <= norm(long.far - p) - 0.5 * options.width;
     WIDTHS
         .iter()
         .map(|&k| k * options.width)
         .find_map(|w| {
             let run = (w * w - height * height).sqrt();
             let depth = foot + run;
-            (w >= height && height.atan2(run) >= min && within(depth, w)).then_some(depth)
+            (w >= height
+                && height.atan2(run) >= min
+                && on_long(depth)
+                && depth <= options.max_depth * w)
+                .then_some(depth)
         })
         .or_else(|| {
             (height < options.width
                 && height >= SQUARE_CUT_MIN_HEIGHT * options.width
                 && foot > 0.0
-                && within(foot, options.width))
-            .then_some(foot)
+                && on_long(foot)
+                && foot * height <= options.max_depth * options.width * options.width)
+                .then_some(foot)
         })
 }
 
@@ -1104,6 +1177,126 @@ mod tests {
         assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
         let foot = short * angle.to_radians().cos();
         assert!((b.area - 0.5 * foot * height).abs() < 1e-9);
+    }
+
+    /// A sliver's tip deeper than [`TipOptions::max_depth`] widths (a 4° tip whose upper side
+    /// ends 17 px out, 1.2 px over the lower one, at 5 px quads) is still cut square from that
+    /// side's end: the piece is a fraction of a quad's area, and the boundary moves by less
+    /// than the sliver is thick. Before, the depth bound (15 px) left the tip whole.
+    #[test]
+    fn a_long_sliver_tip_is_cut_square_when_its_piece_is_small() {
+        let (angle, short, width) = (4.0f64, 17.0, 5.0);
+        let g = hook(angle, short, 60.0, -20.0).unwrap();
+        let options = TipOptions {
+            width,
+            reach: width,
+            ..TipOptions::default()
+        };
+        let (foot, height) = (
+            short * angle.to_radians().cos(),
+            short * angle.to_radians().sin(),
+        );
+        assert!(foot > options.max_depth * width);
+        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        let cut = b.graph.edges().last().unwrap();
+        assert!(cut.ends.contains(&4));
+        let [p, q] = cut.ends.map(|v| b.graph.point(v));
+        assert!((norm(q - p) - height).abs() < 1e-9);
+        assert!((b.area - 0.5 * foot * height).abs() < 1e-9);
+        assert!(b.area < width * width);
+        // The farthest the boundary moved, measured from the tip's vertex to the cut.
+        assert!((b.moved - foot).abs() < 1e-9);
+    }
+
+    /// A tongue of region 0 reaching 8 px into region 1 from their straight boundary, 1.5 px
+    /// wide at its root (a 10.7° tip, as Imesh's sampling leaves across a street's mouth), at
+    /// 6 px quads: no cut a width wide fits, and its sides end 1.5 px apart, but its piece is
+    /// under a quarter of a quad, so it is cut between their ends and region 1 takes it. Before,
+    /// the tip was left whole.
+    #[test]
+    fn a_small_sliver_tip_is_cut_between_its_sides_ends() {
+        let points = vec![
+            Point::new(18.0, 0.0),
+            Point::new(10.0, 0.75),
+            Point::new(10.0, -0.75),
+            Point::new(10.0, 20.0),
+            Point::new(10.0, -20.0),
+            Point::new(-20.0, -20.0),
+            Point::new(40.0, -20.0),
+            Point::new(40.0, 20.0),
+            Point::new(-20.0, 20.0),
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let edges = vec![
+            e(1, 0, [1, 0]),
+            e(0, 2, [1, 0]),
+            e(2, 4, [1, 0]),
+            e(3, 1, [1, 0]),
+            e(5, 4, [0, OUTSIDE]),
+            e(4, 6, [1, OUTSIDE]),
+            e(6, 7, [1, OUTSIDE]),
+            e(7, 3, [1, OUTSIDE]),
+            e(3, 8, [0, OUTSIDE]),
+            e(8, 5, [0, OUTSIDE]),
+        ];
+        let g = CurveGraph::new(points, edges).unwrap();
+        let options = TipOptions {
+            width: 6.0,
+            reach: 6.0,
+            ..TipOptions::default()
+        };
+        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        let cut = b.graph.edges().last().unwrap();
+        assert!(cut.ends == [1, 2] || cut.ends == [2, 1], "{:?}", cut.ends);
+        assert!((b.area - 0.5 * 1.5 * 8.0).abs() < 1e-9);
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&0] - after[&0] - b.area).abs() < 1e-9);
+        assert!((after[&1] - before[&1] - b.area).abs() < 1e-9);
+    }
+
+    /// A lens of region 1, 60 px long and 2 px thick, its two 3.8° tips sharing its straight
+    /// upper side: the first tip's cut takes that edge, and the second is cut in a second
+    /// round, on the edge the first left. Before, an edge was cut at one end only and the
+    /// second tip stayed.
+    #[test]
+    fn two_tips_sharing_an_edge_are_both_cut() {
+        let points = vec![
+            Point::new(0.0, 0.0),
+            Point::new(30.0, -2.0),
+            Point::new(60.0, 0.0),
+            Point::new(-20.0, -20.0),
+            Point::new(80.0, -20.0),
+            Point::new(80.0, 20.0),
+            Point::new(-20.0, 20.0),
+        ];
+        let e = |a, b, labels| GraphEdge {
+            ends: [a, b],
+            labels,
+        };
+        let mut edges: Vec<GraphEdge> = (0..3).map(|k| e(k, (k + 1) % 3, [1, 0])).collect();
+        edges.extend((0..4).map(|k| e(3 + k, 3 + (k + 1) % 4, [0, OUTSIDE])));
+        let g = CurveGraph::new(points, edges).unwrap();
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 2);
+        assert!(b.graph.crossing().is_none());
+        for tip in [0, 2] {
+            assert_eq!(b.graph.valence(tip), 0, "tip {tip} is left");
+        }
+        for v in g.points().len() as u32..b.graph.points().len() as u32 {
+            assert!(sectors_at(&b.graph, v).iter().all(|&(_, a)| a >= 30.0));
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&0] - before[&0] - b.area).abs() < 1e-9);
     }
 
     /// Region 1 from a `angle`° tip at the origin (rotated by `turn` degrees): its lower side
