@@ -853,11 +853,27 @@ mod tests {
 
     /// Cuts of 2 px (and twice that), directions 2 px out.
     fn two_px() -> TipOptions {
+        at_width(2.0)
+    }
+
+    /// Cuts of `width` px, directions `width` px out.
+    fn at_width(width: f64) -> TipOptions {
         TipOptions {
-            width: 2.0,
-            reach: 2.0,
+            width,
+            reach: width,
             ..TipOptions::default()
         }
+    }
+
+    /// `g` with its one tip, at vertex 0, cut off with `options` (straight curves): asserts
+    /// that one tip was cut, that vertex 0 is left unused and that the graph does not cross
+    /// itself.
+    fn cut_once(g: &CurveGraph, options: &TipOptions) -> Blunted {
+        let b = blunt_sharp_tips(g, &straight(g), options).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert_eq!(b.graph.valence(0), 0);
+        b
     }
 
     /// Straight curves for every edge of `g`.
@@ -955,10 +971,7 @@ mod tests {
     fn a_spike_tip_is_cut_where_it_is_one_width_wide() {
         let g = wedge(20.0, 30.0, 15.0, false);
         let options = two_px();
-        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.valence(0), 0);
+        let b = cut_once(&g, &options);
         // The widest cut that leaves room: two widths (4 px) across, 11.5 px from the tip.
         let cut = b.graph.edges().last().unwrap();
         let [p, q] = cut.ends.map(|v| b.graph.point(v));
@@ -1111,10 +1124,7 @@ mod tests {
     #[test]
     fn a_tip_with_a_short_side_is_cut_from_its_end() {
         let g = hook(20.0, 3.0, 30.0, 35.0).unwrap();
-        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.valence(0), 0);
+        let b = cut_once(&g, &two_px());
         // One new vertex; the cut joins it to the short side's end, vertex 4.
         assert_eq!(b.graph.points().len(), g.points().len() + 1);
         let cut = b.graph.edges().last().unwrap();
@@ -1146,15 +1156,8 @@ mod tests {
     fn a_sliver_tip_is_cut_square_from_its_short_side() {
         let (angle, short) = (12.0f64, 11.8);
         let g = hook(angle, short, 30.0, 35.0).unwrap();
-        let options = TipOptions {
-            width: 6.0,
-            reach: 6.0,
-            ..TipOptions::default()
-        };
-        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.valence(0), 0);
+        let options = at_width(6.0);
+        let b = cut_once(&g, &options);
         let cut = b.graph.edges().last().unwrap();
         let new = g.points().len() as u32;
         assert!(cut.ends.contains(&4) && cut.ends.contains(&new));
@@ -1187,20 +1190,13 @@ mod tests {
     fn a_long_sliver_tip_is_cut_square_when_its_piece_is_small() {
         let (angle, short, width) = (4.0f64, 17.0, 5.0);
         let g = hook(angle, short, 60.0, -20.0).unwrap();
-        let options = TipOptions {
-            width,
-            reach: width,
-            ..TipOptions::default()
-        };
+        let options = at_width(width);
         let (foot, height) = (
             short * angle.to_radians().cos(),
             short * angle.to_radians().sin(),
         );
         assert!(foot > options.max_depth * width);
-        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.valence(0), 0);
+        let b = cut_once(&g, &options);
         let cut = b.graph.edges().last().unwrap();
         assert!(cut.ends.contains(&4));
         let [p, q] = cut.ends.map(|v| b.graph.point(v));
@@ -1246,15 +1242,8 @@ mod tests {
             e(8, 5, [0, OUTSIDE]),
         ];
         let g = CurveGraph::new(points, edges).unwrap();
-        let options = TipOptions {
-            width: 6.0,
-            reach: 6.0,
-            ..TipOptions::default()
-        };
-        let b = blunt_sharp_tips(&g, &straight(&g), &options).unwrap();
-        assert_eq!(b.tips, 1);
-        assert!(b.graph.crossing().is_none());
-        assert_eq!(b.graph.valence(0), 0);
+        let options = at_width(6.0);
+        let b = cut_once(&g, &options);
         let cut = b.graph.edges().last().unwrap();
         assert!(cut.ends == [1, 2] || cut.ends == [2, 1], "{:?}", cut.ends);
         assert!((b.area - 0.5 * 1.5 * 8.0).abs() < 1e-9);
