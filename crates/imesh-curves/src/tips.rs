@@ -289,26 +289,21 @@ fn blunt_round(
     refused: &mut Vec<Point>,
 ) -> Option<(Blunted, bool)> {
     let mut tips = sharp_tips(g, curves, options);
-    tips.retain(|tip| !refused.contains(&g.point(tip.vertex)));
+    tips.retain(|cut| !refused.contains(&g.point(cut.tip.vertex)));
     // The sharpest first; an edge is cut at one end only.
-    tips.sort_by(|a, b| a.angle.total_cmp(&b.angle));
+    tips.sort_by(|a, b| a.tip.angle.total_cmp(&b.tip.angle));
     let mut used = vec![false; g.edges().len()];
     let mut cuts = Vec::new();
     let mut deferred = false;
-    for tip in tips {
-        if tip.edges().any(|e| used[e as usize]) {
+    for cut in tips {
+        if cut.tip.edges().any(|e| used[e as usize]) {
             deferred = true;
             continue;
         }
-        let (outline, [i, j], _) = tip.piece(g);
-        for e in tip.edges() {
+        for e in cut.tip.edges() {
             used[e as usize] = true;
         }
-        cuts.push(Cut {
-            tip,
-            ends: [outline[i], outline[j]],
-            outline,
-        });
+        cuts.push(cut);
     }
     // A cut whose new corners would be sharp themselves (a curve turning back across its
     // chord near the cut) is dropped, and the rest made again.
@@ -526,8 +521,8 @@ fn sectors(g: &CurveGraph, curves: &[CubicBezier], v: u32, reach: f64) -> Vec<Se
         .collect()
 }
 
-/// Every sector of `g` narrower than the options' angle that may be cut.
-fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Tip> {
+/// Every sector of `g` narrower than the options' angle that may be cut, with its cut.
+fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Cut> {
     let min = options.min_angle_deg.to_radians();
     let mut tips = Vec::new();
     for v in 0..g.points().len() as u32 {
@@ -628,12 +623,15 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
                 angle,
                 cut,
             };
-            if let Some(tip) = candidates.into_iter().flatten().map(tip).find(|tip| {
+            let sound = candidates.into_iter().flatten().map(tip).find_map(|tip| {
                 let (outline, [i, j], on) = tip.piece(g);
-                sound_piece(g, &on, &outline, [i, j])
-            }) {
-                tips.push(tip);
-            }
+                sound_piece(g, &on, &outline, [i, j]).then(|| Cut {
+                    tip,
+                    ends: [outline[i], outline[j]],
+                    outline,
+                })
+            });
+            tips.extend(sound);
         }
     }
     tips
