@@ -1256,22 +1256,12 @@ mod tests {
     /// second tip stayed.
     #[test]
     fn two_tips_sharing_an_edge_are_both_cut() {
-        let points = vec![
+        let lens = [
             Point::new(0.0, 0.0),
             Point::new(30.0, -2.0),
             Point::new(60.0, 0.0),
-            Point::new(-20.0, -20.0),
-            Point::new(80.0, -20.0),
-            Point::new(80.0, 20.0),
-            Point::new(-20.0, 20.0),
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
-        let mut edges: Vec<GraphEdge> = (0..3).map(|k| e(k, (k + 1) % 3, [1, 0])).collect();
-        edges.extend((0..4).map(|k| e(3 + k, 3 + (k + 1) % 4, [0, OUTSIDE])));
-        let g = CurveGraph::new(points, edges).unwrap();
+        let g = in_frame(&lens, 0.0).unwrap();
         let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
         assert_eq!(b.tips, 2);
         assert!(b.graph.crossing().is_none());
