@@ -387,34 +387,13 @@ fn strip_splits(t: &Triangulation, spacing: f64, lattice: &Lattice) -> StripSpli
         let ideal = (spacing * spacing / height).max(0.5 * spacing);
         let longest = (length / (BOUNDARY_PIECE * spacing)).ceil();
         let (u, w) = (t.origin(h), t.destination(h));
-        // A strip between two sides near one axis: the lattice's lines across each, counted
-        // from the lattice's origin, so that both sides are cut on the same lines and the
-        // strip's cells are (nearly) rectangles. Cut each side on its own, the pieces of
-        // one fall between the other's, and the strip's triangles pair into rhombi (a scaled
-        // Jacobian of 0.33 in a 1.5 px strip along the border). None within half a line's
-        // gap of an end.
-        let at: Vec<Point> = match axis.filter(|_| along_axis) {
+        // A strip between two sides near one axis: the lattice's lines across each.
+        let at = match axis.filter(|_| along_axis) {
             Some(axis) => {
-                // As long as `ideal` and the boundary pieces elsewhere allow, and short enough
-                // for the strip's triangles to need no refinement: every `stride`-th line of
-                // the lattice with its cells cut in `sub`.
-                let gap = lattice.step[axis];
                 let most = ideal
                     .min(BOUNDARY_PIECE * spacing)
                     .min(STRIP_ASPECT * height);
-                let sub = (gap / most).round().max(1.0) as usize;
-                let stride = (most * sub as f64 / gap).floor().max(1.0) as usize;
-                let margin = 0.5 * gap / sub as f64;
-                lattice
-                    .crossings(pa, pb, axis, sub)
-                    .into_iter()
-                    .filter(|&(k, p)| {
-                        k % stride == 0
-                            && p.distance_squared(pa).sqrt() >= margin
-                            && p.distance_squared(pb).sqrt() >= margin
-                    })
-                    .map(|(_, p)| p)
-                    .collect()
+                lattice_cuts(lattice, [pa, pb], axis, most)
             }
             None => Vec::new(),
         };
@@ -426,6 +405,27 @@ fn strip_splits(t: &Triangulation, spacing: f64, lattice: &Lattice) -> StripSpli
         }
     }
     splits
+}
+
+/// Where to cut the side `ends` of a strip running along `axis` into pieces of at most about
+/// `most`: every `stride`-th line of the lattice with its cells cut in `sub`, counted from the
+/// lattice's origin, so that both sides of the strip are cut on the same lines and its cells
+/// are (nearly) rectangles; none within half a line's gap of an end. Cut each side on its
+/// own, the pieces of one fall between the other's, and the strip's triangles pair into
+/// rhombi (a scaled Jacobian of 0.33 in a 1.5 px strip along the border).
+fn lattice_cuts(lattice: &Lattice, ends: [Point; 2], axis: usize, most: f64) -> Vec<Point> {
+    let gap = lattice.step[axis];
+    let sub = (gap / most).round().max(1.0) as usize;
+    let stride = (most * sub as f64 / gap).floor().max(1.0) as usize;
+    let margin = 0.5 * gap / sub as f64;
+    lattice
+        .crossings(ends[0], ends[1], axis, sub)
+        .into_iter()
+        .filter(|&(k, p)| {
+            k % stride == 0 && ends.iter().all(|&e| p.distance_squared(e).sqrt() >= margin)
+        })
+        .map(|(_, p)| p)
+        .collect()
 }
 
 /// The axis a piece of direction `d` runs along within [`NEAR_AXIS`] (0: x, 1: y), if any.
