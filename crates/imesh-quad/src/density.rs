@@ -324,8 +324,9 @@ impl Lattice {
 /// pieces to cut each into so that the strip's two rows of quads are about as long as they are
 /// deep: pieces of length `b` across a strip `H` wide make quads of about `b/2 × H/2`, the mean
 /// quad's area (a quarter of a squared spacing `s²`) at `b = s² / H`, no shorter than a quad
-/// side `s/2`, and on a side more than 5° from an axis no longer than [`STRIP_ASPECT`]` · H`
-/// either (quads at most 2.5 times as long as deep) unless that is under `s/2`. An edge runs
+/// side `s/2`, and on a side more than 5° from an axis no longer than
+/// [`TILTED_STRIP_ASPECT`]` · H` either (quads at most twice as long as deep) unless that is
+/// under `s/2`. An edge runs
 /// along a strip where at least three quarters of the points sampled along it (every half
 /// spacing) have another boundary piece nearer than [`STRIP`] spacings, within 30° of parallel
 /// to it and sharing no end with it; `H` is the (upper) median of those distances. The whole
@@ -388,14 +389,14 @@ fn strip_splits(t: &Triangulation, spacing: f64, lattice: &Lattice) -> StripSpli
         let height = heights[heights.len() / 2].0;
         // No piece shorter than a quad side: quads at least half a side long.
         let ideal = (spacing * spacing / height).max(0.5 * spacing);
-        // Nor, along a tilted side, longer than STRIP_ASPECT depths (above a quad side):
-        // quads at most that many times as long as deep, where the area rule alone left a
-        // strip a pixel or two deep whole, its quads five times as long as deep. A side near
-        // an axis is cut on the lattice's lines instead, or keeps the area rule: cut into
-        // short equal pieces off those lines, its triangles to the lattice skew (a disc near
-        // the border, worst scaled Jacobian 0.504 → 0.384).
+        // Nor, along a tilted side, longer than TILTED_STRIP_ASPECT depths (above a quad
+        // side): quads at most twice as long as deep, where the area rule alone left a strip
+        // a pixel or two deep whole, its quads five times as long as deep. A side near an
+        // axis is cut on the lattice's lines instead, or keeps the area rule: cut into short
+        // equal pieces off those lines, its triangles to the lattice skew (a disc near the
+        // border, worst scaled Jacobian 0.504 → 0.384).
         let ideal = match axis {
-            None => ideal.min((STRIP_ASPECT * height).max(0.5 * spacing)),
+            None => ideal.min((TILTED_STRIP_ASPECT * height).max(0.5 * spacing)),
             Some(_) => ideal,
         };
         let longest = (length / (BOUNDARY_PIECE * spacing)).ceil();
@@ -456,15 +457,17 @@ fn near_axis(d: Point) -> Option<usize> {
 /// on the lattice's lines (simplification tilts a pixel row's boundary by a pixel or so).
 const NEAR_AXIS: f64 = 0.087_488_663_525_924;
 
-/// The longest piece along a strip, in strip depths. Cut on the lattice's lines, the strip's
+/// The longest piece along a strip cut on the lattice's lines, in strip depths: the strip's
 /// triangles then have angles of 21.8° or more, above refinement's 20.7°, which would split the
-/// pieces of one side only, between the other's. Cut into equal pieces, a tilted strip's quads
-/// are at most 2.5 times as long as deep: measured over 150 images (session 47's), the quads
-/// with a shape under 0.5 went from 546 to 419 and those with a scaled Jacobian under 0.5 from
-/// 82 to 63, the means within 0.002; at 2 depths (sides near an axis bounded too) 317 and 51,
-/// but one image's mean −0.010 (a band along the border cut into quads half the size); at 1.5
-/// the means fell on 27 images; at 3 depths 474 and 73.
+/// pieces of one side only, between the other's.
 const STRIP_ASPECT: f64 = 2.5;
+
+/// The longest piece along a tilted strip (cut into equal pieces), in strip depths, unless
+/// that is under a quad side: its quads at most twice as long as deep. Measured over 150
+/// images (session 47's), the quads with a shape under 0.5 went from 546 to 372 and those with
+/// a scaled Jacobian under 0.5 from 82 to 59, the means within 0.003; at 2.5 depths 419 and 63,
+/// at 3 474 and 73; at 1.75 332 and 54 but the means lower on 11 images, at 1.5 on 21.
+const TILTED_STRIP_ASPECT: f64 = 2.0;
 
 /// The cuts [`strip_splits`] makes: equal pieces, or at given points (in order from the
 /// first vertex).
@@ -552,11 +555,12 @@ mod tests {
     }
 
     /// A strip 1 deep and 10 long at 36.9° (a parallelogram region) in a 40 × 20 domain at
-    /// spacing 4: its long sides are cut into four pieces of 2.5, quads at most 2.5 times as
-    /// long as deep, where the area rule alone (pieces of `s² / H` = 16) left them to the
-    /// 1.5-spacing rule's two pieces of 5 (quads five times as long as deep).
+    /// spacing 4: its long sides are cut into five pieces of 2 (a quad side: the bound, two
+    /// depths, is no shorter), quads about twice as long as deep, where the area rule alone
+    /// (pieces of `s² / H` = 16) left them to the 1.5-spacing rule's two pieces of 5 (quads
+    /// five times as long as deep).
     #[test]
-    fn a_tilted_thin_strip_gets_pieces_at_most_two_and_a_half_depths_long() {
+    fn a_tilted_thin_strip_gets_pieces_at_most_two_depths_long() {
         let (d, n) = (Point::new(0.8, 0.6), Point::new(-0.6, 0.8));
         let a = Point::new(10.0, 5.0);
         let b = a + n;
@@ -582,8 +586,8 @@ mod tests {
                 .filter(|&[p, q]| on(p) && on(q))
                 .map(|[p, q]| p.distance_squared(q).sqrt())
                 .collect();
-            assert_eq!(pieces.len(), 4, "{start:?}: {pieces:?}");
-            assert!(pieces.iter().all(|&l| (l - 2.5).abs() < 1e-9), "{pieces:?}");
+            assert_eq!(pieces.len(), 5, "{start:?}: {pieces:?}");
+            assert!(pieces.iter().all(|&l| (l - 2.0).abs() < 1e-9), "{pieces:?}");
         }
     }
 
