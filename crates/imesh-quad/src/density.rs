@@ -506,6 +506,19 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The lengths of the segment pieces on the line through `through` along `direction`.
+    fn pieces_on_line(t: &Triangulation, through: Point, direction: Point) -> Vec<f64> {
+        let on = |p: Point| {
+            let r = p - through;
+            (r.x * direction.y - r.y * direction.x).abs() < 1e-9
+        };
+        t.constrained_edges()
+            .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
+            .filter(|&[a, b]| on(a) && on(b))
+            .map(|[a, b]| a.distance_squared(b).sqrt())
+            .collect()
+    }
+
     /// A strip 4.4 deep across a 40 × 20 domain at spacing 4 (no lattice point fits in it),
     /// rising 4 over its length (5.7°: a strip nearer an axis is cut on the lattice's lines
     /// instead): its two boundaries are cut into pieces about as long as the strip is deep
@@ -532,14 +545,8 @@ mod tests {
         uniform_points(&mut t, 4.0).unwrap();
         t.check().unwrap();
         // The pieces on the line y = y0 + rise · x (the border's with rise 0).
-        let pieces_along = |y0: f64, rise: f64| -> Vec<f64> {
-            let on = |p: Point| (p.y - (y0 + rise * p.x)).abs() < 1e-9;
-            t.constrained_edges()
-                .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
-                .filter(|&[a, b]| on(a) && on(b))
-                .map(|[a, b]| a.distance_squared(b).sqrt())
-                .collect()
-        };
+        let pieces_along =
+            |y0: f64, rise: f64| pieces_on_line(&t, Point::new(0.0, y0), Point::new(1.0, rise));
         let length = (40.0f64 * 40.0 + 4.0 * 4.0).sqrt();
         for y0 in [6.0, 10.4] {
             let pieces = pieces_along(y0, 0.1);
@@ -576,16 +583,7 @@ mod tests {
         uniform_points(&mut t, 4.0).unwrap();
         t.check().unwrap();
         for start in [a, b] {
-            let on = |p: Point| {
-                let r = p - start;
-                (r.x * d.y - r.y * d.x).abs() < 1e-9
-            };
-            let pieces: Vec<f64> = t
-                .constrained_edges()
-                .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
-                .filter(|&[p, q]| on(p) && on(q))
-                .map(|[p, q]| p.distance_squared(q).sqrt())
-                .collect();
+            let pieces = pieces_on_line(&t, start, d);
             assert_eq!(pieces.len(), 5, "{start:?}: {pieces:?}");
             assert!(pieces.iter().all(|&l| (l - 2.0).abs() < 1e-9), "{pieces:?}");
         }
