@@ -506,6 +506,23 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The triangulation of `points` with the `segments` between them, its regions labelled
+    /// from `seeds`, and the points of a uniform DT' of spacing 4 inserted.
+    fn uniform_at_4(
+        points: &[Point],
+        segments: &[(usize, usize)],
+        seeds: &[(Point, u32)],
+    ) -> Triangulation {
+        let (mut t, v) = Triangulation::from_points(points).unwrap();
+        for &(a, b) in segments {
+            t.insert_segment(v[a], v[b]).unwrap();
+        }
+        t.label_regions(seeds);
+        uniform_points(&mut t, 4.0).unwrap();
+        t.check().unwrap();
+        t
+    }
+
     /// The lengths of the segment pieces on the line through `through` along `direction`.
     fn pieces_on_line(t: &Triangulation, through: Point, direction: Point) -> Vec<f64> {
         let on = |p: Point| {
@@ -533,17 +550,15 @@ mod tests {
             .chain(&strip)
             .map(|&p| Point::from(p))
             .collect();
-        let (mut t, v) = Triangulation::from_points(&points).unwrap();
-        for (a, b) in [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (7, 6)] {
-            t.insert_segment(v[a], v[b]).unwrap();
-        }
-        t.label_regions(&[
-            (Point::new(20.0, 4.0), 0),
-            (Point::new(20.0, 10.2), 1),
-            (Point::new(20.0, 16.0), 2),
-        ]);
-        uniform_points(&mut t, 4.0).unwrap();
-        t.check().unwrap();
+        let t = uniform_at_4(
+            &points,
+            &[(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (7, 6)],
+            &[
+                (Point::new(20.0, 4.0), 0),
+                (Point::new(20.0, 10.2), 1),
+                (Point::new(20.0, 16.0), 2),
+            ],
+        );
         // The pieces on the line y = y0 + rise · x (the border's with rise 0).
         let pieces_along =
             |y0: f64, rise: f64| pieces_on_line(&t, Point::new(0.0, y0), Point::new(1.0, rise));
@@ -574,14 +589,20 @@ mod tests {
         let corners = [(0.0, 0.0), (40.0, 0.0), (40.0, 20.0), (0.0, 20.0)].map(Point::from);
         let strip = [a, a + d * 10.0, b + d * 10.0, b];
         let points: Vec<Point> = corners.iter().chain(&strip).copied().collect();
-        let (mut t, v) = Triangulation::from_points(&points).unwrap();
-        for k in 0..4 {
-            t.insert_segment(v[k], v[(k + 1) % 4]).unwrap();
-            t.insert_segment(v[4 + k], v[4 + (k + 1) % 4]).unwrap();
-        }
-        t.label_regions(&[(Point::new(30.0, 4.0), 0), (a + d * 5.0 + n * 0.5, 1)]);
-        uniform_points(&mut t, 4.0).unwrap();
-        t.check().unwrap();
+        let t = uniform_at_4(
+            &points,
+            &[
+                (0, 1),
+                (1, 2),
+                (2, 3),
+                (3, 0),
+                (4, 5),
+                (5, 6),
+                (6, 7),
+                (7, 4),
+            ],
+            &[(Point::new(30.0, 4.0), 0), (a + d * 5.0 + n * 0.5, 1)],
+        );
         for start in [a, b] {
             let pieces = pieces_on_line(&t, start, d);
             assert_eq!(pieces.len(), 5, "{start:?}: {pieces:?}");
@@ -606,13 +627,11 @@ mod tests {
         .iter()
         .map(|&p| Point::from(p))
         .collect();
-        let (mut t, v) = Triangulation::from_points(&points).unwrap();
-        for (a, b) in [(0, 1), (1, 5), (5, 2), (2, 3), (3, 4), (4, 0), (4, 5)] {
-            t.insert_segment(v[a], v[b]).unwrap();
-        }
-        t.label_regions(&[(Point::new(20.0, 10.0), 0), (Point::new(20.0, 19.5), 1)]);
-        uniform_points(&mut t, 4.0).unwrap();
-        t.check().unwrap();
+        let t = uniform_at_4(
+            &points,
+            &[(0, 1), (1, 5), (5, 2), (2, 3), (3, 4), (4, 0), (4, 5)],
+            &[(Point::new(20.0, 10.0), 0), (Point::new(20.0, 19.5), 1)],
+        );
         // The x of the vertices strictly inside each side, in order.
         let inside_on = |y: &dyn Fn(f64) -> f64| -> Vec<f64> {
             let mut xs: Vec<f64> = t
@@ -649,13 +668,11 @@ mod tests {
             (13.0, 20.0),
         ]
         .map(Point::from);
-        let (mut t, v) = Triangulation::from_points(&points).unwrap();
-        for (a, b) in [(0, 4), (4, 1), (1, 2), (2, 5), (5, 3), (3, 0), (4, 5)] {
-            t.insert_segment(v[a], v[b]).unwrap();
-        }
-        t.label_regions(&[(Point::new(5.0, 10.0), 0), (Point::new(30.0, 10.0), 1)]);
-        uniform_points(&mut t, 4.0).unwrap();
-        t.check().unwrap();
+        let t = uniform_at_4(
+            &points,
+            &[(0, 4), (4, 1), (1, 2), (2, 5), (5, 3), (3, 0), (4, 5)],
+            &[(Point::new(5.0, 10.0), 0), (Point::new(30.0, 10.0), 1)],
+        );
         let pieces: Vec<[Point; 2]> = t
             .constrained_edges()
             .map(|h| [t.point(t.origin(h)), t.point(t.destination(h))])
