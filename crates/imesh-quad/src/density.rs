@@ -326,12 +326,11 @@ impl Lattice {
 /// quad's area (a quarter of a squared spacing `s²`) at `b = s² / H`, no shorter than a quad
 /// side `s/2`, and on a side more than 5° from an axis no longer than
 /// [`TILTED_STRIP_ASPECT`]` · H` either (quads at most twice as long as deep) unless that is
-/// under `s/2`. An edge runs
-/// along a strip where at least three quarters of the points sampled along it (every half
-/// spacing) have another boundary piece nearer than [`STRIP`] spacings, within 30° of parallel
-/// to it and sharing no end with it; `H` is the (upper) median of those distances. The whole
-/// edge is cut (a G' edge at this step): cutting the pieces [`BOUNDARY_PIECE`] leaves in two
-/// made them too short.
+/// under `s/2`. An edge runs along a strip where at least three quarters of the points sampled
+/// along it (every half spacing) have another boundary piece nearer than [`STRIP`] spacings,
+/// within 30° of parallel to it and sharing no end with it; `H` is the (upper) median of those
+/// distances. The whole edge is cut (a G' edge at this step): cutting the pieces
+/// [`BOUNDARY_PIECE`] leaves in two made them too short.
 ///
 /// Where the edge and most of the pieces across run within 5° of one axis ([`NEAR_AXIS`]), it
 /// is cut where the lattice's lines cross it instead (every few lines, or the lines and
