@@ -15,6 +15,8 @@ use crate::predicates::orient2d;
 use crate::triangulation::{next, prev, Inserted, GHOST, NONE};
 use crate::{GeomError, Point, TriangleId, Triangulation, VertexId, EXTERIOR};
 
+use std::collections::HashSet;
+
 /// Parameters of [`Triangulation::refine`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RefineOptions {
@@ -165,12 +167,37 @@ struct Queues {
     encroached: Vec<[u32; 2]>,
     /// cos²θ for the angle bound θ.
     cos2_bound: f64,
+    /// Triangles held to a stricter bound (their vertices, as [`Triangulation::triangle_vertices`]
+    /// gives them: a slot that another triangle takes over is not one of them), and that bound's
+    /// cos²; empty for a plain refinement.
+    strict: HashSet<[u32; 3]>,
+    cos2_strict: f64,
     /// The area bound.
     max_area: Option<f64>,
     /// How far off-centres lie from their edge, in shortest-edge lengths.
     off_constant: f64,
     /// cos²(2θ): the diametral lens of encroachment.
     lens: f64,
+}
+
+impl Queues {
+    /// cos² of the angle bound of the triangle with these vertices.
+    fn bound_of(&self, vertices: &[u32; 3]) -> f64 {
+        if !self.strict.is_empty() && self.strict.contains(vertices) {
+            self.cos2_strict
+        } else {
+            self.cos2_bound
+        }
+    }
+}
+
+/// Refinement's angle bounds: positive, and at most 34° (above it refinement need not stop).
+fn check_angle(degrees: f64) -> Result<(), GeomError> {
+    if degrees > 0.0 && degrees <= 34.0 {
+        Ok(())
+    } else {
+        Err(GeomError::BadAngle { degrees })
+    }
 }
 
 /// Where to split a segment piece that a vertex of another segment encroaches.
@@ -306,12 +333,58 @@ impl Triangulation {
     pub fn refine_with_policy(
         &mut self,
         options: &RefineOptions,
+        policy: impl FnMut(&Triangulation, &Candidate) -> bool,
+    ) -> Result<RefineReport, GeomError> {
+        self.refine_from(options, None, policy)
+    }
+
+    /// Refinement restarted on a few `triangles` of a triangulation already refined to
+    /// `options`: each of them is bad while its smallest angle is under `angle_deg` (which may
+    /// exceed `options.min_angle_deg`, up to 34°), and the triangles their new points make are
+    /// held to `options`, with `policy` as in [`refine_with_policy`](Self::refine_with_policy).
+    /// The rest of the triangulation is not looked at (it met `options` already), and the
+    /// points of the earlier refinement count as input points here (the concentric shells of
+    /// segment splits are drawn around them too). A caller that knows which few triangles a
+    /// coarse bound leaves too sharp for its use refines only those.
+    ///
+    /// ```
+    /// use imesh_geom::{Point, RefineOptions, Triangulation};
+    /// // A 4 × 1.7 rectangle: two triangles with a 23° corner, which 20.7° leaves.
+    /// let pts = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.7), (0.0, 1.7)].map(|(x, y)| Point::new(x, y));
+    /// let (mut t, _) = Triangulation::from_points(&pts).unwrap();
+    /// let options = RefineOptions::default();
+    /// assert_eq!(t.refine(&options).unwrap().inserted, 0);
+    /// // The first of them refined to 25°.
+    /// let first: Vec<_> = t.triangles().take(1).collect();
+    /// let report = t.refine_triangles_with_policy(&first, 25.0, &options, |_, _| true).unwrap();
+    /// assert!(report.inserted > 0);
+    /// t.check().unwrap();
+    /// ```
+    ///
+    /// # Errors
+    /// As [`refine`](Self::refine), for `angle_deg` too.
+    pub fn refine_triangles_with_policy(
+        &mut self,
+        triangles: &[TriangleId],
+        angle_deg: f64,
+        options: &RefineOptions,
+        policy: impl FnMut(&Triangulation, &Candidate) -> bool,
+    ) -> Result<RefineReport, GeomError> {
+        check_angle(angle_deg)?;
+        let strict = triangles.iter().map(|&t| self.corner_ids(t.0)).collect();
+        self.refine_from(options, Some((strict, angle_deg)), policy)
+    }
+
+    /// Refinement of every triangle to `options`, or, with `strict`, of those triangles to its
+    /// stricter bound (and of the triangles their points make to `options`).
+    fn refine_from(
+        &mut self,
+        options: &RefineOptions,
+        strict: Option<(HashSet<[u32; 3]>, f64)>,
         mut policy: impl FnMut(&Triangulation, &Candidate) -> bool,
     ) -> Result<RefineReport, GeomError> {
         let deg = options.min_angle_deg;
-        if !(deg > 0.0 && deg <= 34.0) {
-            return Err(GeomError::BadAngle { degrees: deg });
-        }
+        check_angle(deg)?;
         let mut report = RefineReport {
             inserted: 0,
             bad_left: 0,
@@ -329,18 +402,30 @@ impl Triangulation {
         };
         let all = 0..self.origin.len() as u32 / 3;
         let lens = (2.0 * min_angle).cos().powi(2);
+        let restart = strict.is_some();
+        let (strict, strict_deg) = strict.unwrap_or_default();
         let mut queues = Queues {
             bad: BadQueue::default(),
             encroached: Vec::new(),
             cos2_bound: min_angle.cos().powi(2),
+            strict,
+            cos2_strict: strict_deg.to_radians().cos().powi(2),
             max_area: options.max_area,
             // Üngör's off-centre distance, as a multiple of the shortest edge: 0.475·cot(θ/2),
             // just short of the apex of the isosceles triangle with angle θ on that edge.
             off_constant: 0.475 / (0.5 * min_angle).tan(),
             lens,
         };
-        self.encroached_among(all.clone(), lens, &mut queues.encroached);
-        self.queue_bad(all, &mut queues);
+        if restart {
+            // Only the strict triangles: the rest met `options` when they were made.
+            let slots: Vec<u32> = all
+                .filter(|&t| queues.strict.contains(&self.corner_ids(t)))
+                .collect();
+            self.queue_bad(slots, &mut queues);
+        } else {
+            self.encroached_among(all.clone(), lens, &mut queues.encroached);
+            self.queue_bad(all, &mut queues);
+        }
         // Segments that must be split whether or not a vertex encroaches them now: they block a
         // circumcentre, or the circumcentre would encroach them.
         let mut forced: Vec<[u32; 2]> = Vec::new();
@@ -376,7 +461,7 @@ impl Triangulation {
             }
             let Some(bad) = queues.bad.pop() else { break };
             let t = bad.slot;
-            if self.origin[3 * t as usize..3 * t as usize + 3] != bad.vertices {
+            if self.corner_ids(t) != bad.vertices {
                 continue;
             }
             let p = self.triangle_points(TriangleId(t));
@@ -384,7 +469,7 @@ impl Triangulation {
                 corner,
                 shortest,
                 bad: skinny,
-            } = smallest_angle(p, queues.cos2_bound);
+            } = smallest_angle(p, queues.bound_of(&bad.vertices));
             let too_big = options
                 .max_area
                 .is_some_and(|m| self.signed_area(TriangleId(t)) > m);
@@ -635,6 +720,12 @@ impl Triangulation {
         Ok(())
     }
 
+    /// The vertices of the triangle in slot `t`, as a [`Bad`] entry records them.
+    fn corner_ids(&self, t: u32) -> [u32; 3] {
+        let b = 3 * t as usize;
+        [self.origin[b], self.origin[b + 1], self.origin[b + 2]]
+    }
+
     fn refinable(&self, t: u32) -> bool {
         !self.is_ghost_slot(t) && (self.label.is_empty() || self.label[t as usize] != EXTERIOR)
     }
@@ -646,13 +737,12 @@ impl Triangulation {
                 continue;
             }
             let p = self.triangle_points(TriangleId(t));
-            let SmallestAngle { shortest, bad, .. } = smallest_angle(p, queues.cos2_bound);
+            let vertices = self.corner_ids(t);
+            let SmallestAngle { shortest, bad, .. } = smallest_angle(p, queues.bound_of(&vertices));
             let too_big = queues
                 .max_area
                 .is_some_and(|m| self.signed_area(TriangleId(t)) > m);
             if bad || too_big {
-                let b = 3 * t as usize;
-                let vertices = [self.origin[b], self.origin[b + 1], self.origin[b + 2]];
                 queues.bad.push(shortest, Bad { vertices, slot: t });
             }
         }

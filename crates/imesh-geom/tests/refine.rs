@@ -81,6 +81,48 @@ fn spans_small_angle(t: &Triangulation, f: TriangleId, segments: &[[Point; 2]]) 
     })
 }
 
+/// The PSLG of a `w` × `h` label image, labelled: unit segments between pixels of different
+/// labels and on the border, and only the pixel corners they use (large empty regions, so
+/// refinement has work to do).
+fn label_grid_pslg(w: u32, h: u32, label: impl Fn(u32, u32) -> u32) -> Triangulation {
+    let mut segs: Vec<((u32, u32), (u32, u32))> = Vec::new();
+    for r in 0..=h {
+        for c in 0..w {
+            if r == 0 || r == h || label(c, r - 1) != label(c, r) {
+                segs.push(((c, r), (c + 1, r)));
+            }
+        }
+    }
+    for c in 0..=w {
+        for r in 0..h {
+            if c == 0 || c == w || label(c - 1, r) != label(c, r) {
+                segs.push(((c, r), (c, r + 1)));
+            }
+        }
+    }
+    let mut corners: Vec<(u32, u32)> = segs.iter().flat_map(|&(p, q)| [p, q]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let pts: Vec<Point> = corners
+        .iter()
+        .map(|&(c, r)| Point::new(f64::from(c), f64::from(r)))
+        .collect();
+    let (mut t, ids) = Triangulation::from_points(&pts).unwrap();
+    let id = |p: (u32, u32)| ids[corners.binary_search(&p).unwrap()];
+    for &(p, q) in &segs {
+        t.insert_segment(id(p), id(q)).unwrap();
+    }
+    let seeds: Vec<(Point, u32)> = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (r, c)))
+        .map(|(r, c)| {
+            let centre = Point::new(f64::from(c) + 0.5, f64::from(r) + 0.5);
+            (centre, label(c, r))
+        })
+        .collect();
+    t.label_regions(&seeds);
+    t
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
@@ -178,34 +220,7 @@ proptest! {
     #[test]
     fn grid_boundaries_of_random_label_images(w in 2u32..9, h in 2u32..9, cells in prop::collection::vec(0u32..3, 81), theta in prop::sample::select(vec![20.7, 28.0, 33.0])) {
         let label = |c: u32, r: u32| cells[(r * 9 + c) as usize];
-        // The PSLG: unit segments between pixels of different labels and on the border, and only
-        // the pixel corners they use (large empty regions, so refinement has work to do).
-        let mut segs: Vec<((u32, u32), (u32, u32))> = Vec::new();
-        for r in 0..=h {
-            for c in 0..w {
-                if r == 0 || r == h || label(c, r - 1) != label(c, r) {
-                    segs.push(((c, r), (c + 1, r)));
-                }
-            }
-        }
-        for c in 0..=w {
-            for r in 0..h {
-                if c == 0 || c == w || label(c - 1, r) != label(c, r) {
-                    segs.push(((c, r), (c, r + 1)));
-                }
-            }
-        }
-        let mut corners: Vec<(u32, u32)> = segs.iter().flat_map(|&(p, q)| [p, q]).collect();
-        corners.sort_unstable();
-        corners.dedup();
-        let pts: Vec<Point> = corners.iter().map(|&(c, r)| Point::new(f64::from(c), f64::from(r))).collect();
-        let (mut t, ids) = Triangulation::from_points(&pts).unwrap();
-        let id = |p: (u32, u32)| ids[corners.binary_search(&p).unwrap()];
-        for &(p, q) in &segs {
-            t.insert_segment(id(p), id(q)).unwrap();
-        }
-        let seeds: Vec<(Point, u32)> = (0..h).flat_map(|r| (0..w).map(move |c| (Point::new(f64::from(c) + 0.5, f64::from(r) + 0.5), label(c, r)))).collect();
-        t.label_regions(&seeds);
+        let mut t = label_grid_pslg(w, h, label);
         let before = t.num_vertices();
         let report = t.refine(&RefineOptions { min_angle_deg: theta, max_steiner: 20_000, ..Default::default() }).unwrap();
         prop_assert_eq!(report.stopped, StopReason::Done);
@@ -214,6 +229,50 @@ proptest! {
         for f in t.triangles() {
             let p = centroid(&t, f);
             prop_assert_eq!(t.label(f), label(p.x as u32, p.y as u32));
+        }
+    }
+
+    #[test]
+    fn a_restart_refines_the_named_triangles_to_their_stricter_angle(w in 2u32..9, h in 2u32..9, cells in prop::collection::vec(0u32..3, 81), strict in prop::sample::select(vec![25.0, 30.0, 34.0]), every in 1usize..4) {
+        let label = |c: u32, r: u32| cells[(r * 9 + c) as usize];
+        let mut t = label_grid_pslg(w, h, label);
+        let options = RefineOptions { min_angle_deg: 20.7, max_steiner: 20_000, ..Default::default() };
+        t.refine(&options).unwrap();
+        let sorted = |t: &Triangulation, f: TriangleId| {
+            let mut v = t.triangle_vertices(f).map(|v| v.index());
+            v.sort_unstable();
+            v
+        };
+        // Every `every`-th triangle under the stricter angle (and not at an input angle) is named.
+        let named: Vec<TriangleId> = t
+            .triangles()
+            .filter(|&f| matches!(smallest(&t, f), (a, false) if a < strict))
+            .step_by(every)
+            .collect();
+        let named_vertices: Vec<[usize; 3]> = named.iter().map(|&f| sorted(&t, f)).collect();
+        let others: Vec<[usize; 3]> = t
+            .triangles()
+            .filter(|f| !named.contains(f))
+            .map(|f| sorted(&t, f))
+            .collect();
+        let before = t.num_vertices();
+        let report = t.refine_triangles_with_policy(&named, strict, &options, |_, _| true).unwrap();
+        prop_assert_eq!(report.stopped, StopReason::Done);
+        prop_assert_eq!(t.num_vertices(), before + report.inserted);
+        prop_assert_eq!(report.inserted > 0, !named.is_empty());
+        // Still a conforming Delaunay triangulation refined to the plain bound, with its labels.
+        assert_refined(&t, 20.7);
+        for f in t.triangles() {
+            let p = centroid(&t, f);
+            prop_assert_eq!(t.label(f), label(p.x as u32, p.y as u32));
+        }
+        // No named triangle is left; and the unnamed ones under the stricter angle were not
+        // refined for it (with no named triangle, nothing at all changed).
+        let now: Vec<[usize; 3]> = t.triangles().map(|f| sorted(&t, f)).collect();
+        prop_assert!(named_vertices.iter().all(|v| !now.contains(v)));
+        if named.is_empty() {
+            prop_assert_eq!(now.len(), others.len());
+            prop_assert!(others.iter().all(|v| now.contains(v)));
         }
     }
 }
@@ -273,6 +332,12 @@ fn angles_above_34_degrees_are_refused() {
             ..Default::default()
         })
         .is_err());
+    // The stricter bound of a restart too.
+    let all: Vec<TriangleId> = t.triangles().collect();
+    let e = t
+        .refine_triangles_with_policy(&all, 35.0, &RefineOptions::default(), |_, _| true)
+        .unwrap_err();
+    assert_eq!(e, GeomError::BadAngle { degrees: 35.0 });
 }
 
 #[test]

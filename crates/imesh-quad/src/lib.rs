@@ -52,7 +52,10 @@ mod template;
 pub use adapt::{adapt, adapt_within, AdaptReport, EdgeCurve, LOCAL_ROUNDS, POOR_SCALED_JACOBIAN};
 pub use chains::BoundaryChain;
 pub use density::{uniform_points, uniform_points_with_lattice, BOUNDARY_PIECE, CLEARANCE, STRIP};
-pub use dt::{DensityOptions, RegionTriangulation, BOUNDARY_CLEARANCE, MAX_TRIANGLE_AREA, NONE};
+pub use dt::{
+    DensityOptions, RegionTriangulation, BOUNDARY_CLEARANCE, MAX_TRIANGLE_AREA, NONE,
+    SHARP_UNPAIRED_CORNER,
+};
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
 pub use pairing::{Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER};
 pub use patch::{basis, ControlNet, TRIANGLE_SLOTS};
@@ -186,9 +189,14 @@ pub fn remesh(
         });
     }
     let clock = std::time::Instant::now();
-    let dt = RegionTriangulation::new(g, &options.density)?;
-    let triangulation = clock.elapsed().as_secs_f64();
-    let elements = ElementMesh::pair(&dt.triangulation, options.pairing);
+    let mut dt = RegionTriangulation::new(g, &options.density)?;
+    let mut triangulation = clock.elapsed().as_secs_f64();
+    let mut elements = ElementMesh::pair(&dt.triangulation, options.pairing);
+    let paired = clock.elapsed().as_secs_f64();
+    if dt.open_sharp_unpaired(&elements, &options.density)? > 0 {
+        triangulation += clock.elapsed().as_secs_f64() - paired;
+        elements = ElementMesh::pair(&dt.triangulation, options.pairing);
+    }
     let pairing = clock.elapsed().as_secs_f64() - triangulation;
     let quads = elements.quad_count(options.level);
     if quads > options.max_quads {

@@ -6,11 +6,11 @@ use imesh_classify::LabelGrid;
 use imesh_curves::{
     fit_edges, segment_distance, simplify, CurveGraph, FitOptions, SimplifyOptions,
 };
-use imesh_geom::Point;
+use imesh_geom::{Point, Triangulation};
 use imesh_quad::{
     adapt_within, remesh, ControlNet, DensityOptions, Element, ElementMesh, Pairing, QuadError,
-    QuadMesh, QuadOptions, Remesh, BOUNDARY_PIECE, MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER,
-    MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
+    QuadMesh, QuadOptions, RegionTriangulation, Remesh, BOUNDARY_PIECE, MAX_TRIANGLE_AREA,
+    MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN, SHARP_UNPAIRED_CORNER,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -870,4 +870,86 @@ fn damping_keeps_the_largest_share_that_passes() {
     assert_eq!(shares[0], 1.0);
     assert!(shares.windows(2).all(|w| w[1] < w[0]), "{shares:?}");
     assert!(shares[3] <= 0.125, "{shares:?}");
+}
+
+/// The unpaired triangles of `m` with a corner under `degrees` between two sides of which one
+/// lies on a boundary (a segment of `t`).
+fn sharp_unpaired(t: &Triangulation, m: &ElementMesh, degrees: f64) -> usize {
+    t.triangles()
+        .filter(|&f| {
+            let e = m.element_of_triangle[f.index()] as usize;
+            let sides = t.triangle_edges(f);
+            let p = t.triangle_points(f);
+            matches!(m.elements[e], Element::Triangle(_))
+                && (0..3).any(|k| {
+                    let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                    let angle = (a.x * b.y - a.y * b.x).atan2(a.x * b.x + a.y * b.y);
+                    let on_boundary =
+                        t.is_constrained(sides[k]) != t.is_constrained(sides[(k + 2) % 3]);
+                    on_boundary && angle.to_degrees() < degrees
+                })
+        })
+        .count()
+}
+
+#[test]
+fn unpaired_triangles_sharp_at_a_boundary_are_refined_once_more() {
+    let options = QuadOptions {
+        density: DensityOptions {
+            spacing: Some(4.0),
+            ..Default::default()
+        },
+        pairing: Pairing::Matching,
+        ..Default::default()
+    };
+    let (mut before, mut after) = (0, 0);
+    for name in FIXTURES {
+        let c = curves(&support::fixture(name));
+        let first = RegionTriangulation::new(&c.simplified.graph, &options.density).unwrap();
+        let paired = ElementMesh::pair(&first.triangulation, Pairing::Matching);
+        let sharp = sharp_unpaired(&first.triangulation, &paired, SHARP_UNPAIRED_CORNER);
+        let r = run(&c, &options);
+        check_mesh(&r, &c, &r.mesh.vertices);
+        let left = sharp_unpaired(&r.dt.triangulation, &r.elements, SHARP_UNPAIRED_CORNER);
+        // The second refinement's points come after the first's, and are counted with them.
+        let added = r.dt.triangulation.num_vertices() - first.triangulation.num_vertices();
+        assert_eq!(
+            added,
+            r.dt.refinement.inserted - first.refinement.inserted,
+            "{name}"
+        );
+        assert_eq!(
+            added > 0,
+            sharp > 0,
+            "{name}: {sharp} sharp, {added} points"
+        );
+        eprintln!("{name}: {sharp} sharp unpaired triangles, {left} after, {added} points");
+        (before, after) = (before + sharp, after + left);
+    }
+    // New triangles are paired anew, and a few of them are left sharp in turn (a second pass
+    // measured no better: docs/measurements.md, session 49).
+    assert!(before > 0 && 2 * after < before, "{before} → {after}");
+    // A graded DT', and a refinement to that angle already, are left as they were.
+    let c = curves(&support::fixture(FIXTURES[0]));
+    for density in [
+        DensityOptions::default(),
+        DensityOptions {
+            spacing: Some(4.0),
+            min_angle_deg: SHARP_UNPAIRED_CORNER,
+            ..Default::default()
+        },
+    ] {
+        let first = RegionTriangulation::new(&c.simplified.graph, &density).unwrap();
+        let options = QuadOptions {
+            density,
+            pairing: Pairing::Matching,
+            ..Default::default()
+        };
+        let r = run(&c, &options);
+        assert_eq!(r.dt.refinement, first.refinement);
+        assert_eq!(
+            r.dt.triangulation.num_vertices(),
+            first.triangulation.num_vertices()
+        );
+    }
 }

@@ -155,9 +155,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         // before), a quad of a strip 1.5 px wide along the border, under its 29.6° corner, is
         // at 0.5 since its neighbourhood moves as a whole (below); grass's, 0.485 once its tips with a short side are cut from that side's end (0.447
         // at a 27° corner before), a quad of a gap 1.4 px wide between two regions; aloe's,
-        // 0.361 since junctions three quarters of a quad apart are merged (0.352 at a 20.7°
-        // corner before; its sharpest is now 23.9°), a quad of its tangles of pixel-wide
-        // regions.
+        // 0.361 once junctions three quarters of a quad apart were merged (0.352 at a 20.7°
+        // corner before), a quad of its tangles of pixel-wide regions, and now at its sharpest
+        // corner's bound (23.9°) since unpaired triangles sharp beside a boundary are refined
+        // once more.
         let corner = r
             .sharpest_boundary_corner
             .expect("a quad mesh has boundary corners");
@@ -363,8 +364,10 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     assert!(mean(&channels) >= 0.865, "{}", mean(&channels));
     assert_eq!(mri.counts.lattice_scale, 1.0);
     // 0.9086 since thin strips' pieces are cut (0.9113 before): a strip-shaped island's
-    // shorter pieces make the band outside it finer.
-    assert!(mean(&mri) >= 0.905);
+    // shorter pieces make the band outside it finer; 0.9048 since unpaired triangles sharp
+    // beside a boundary are refined once more (0.9072 before: 3 points, 12 more quads, so a
+    // mean quad area 0.12 % lower, against which every lattice square scores 0.9976).
+    assert!(mean(&mri) >= 0.904);
 }
 
 /// The lattice's second try is only a try: on grass it is finer (0.969) and makes 69 634
