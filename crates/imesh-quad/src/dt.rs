@@ -209,9 +209,17 @@ impl RegionTriangulation {
                 Some(Element::Triangle(_))
             )
         };
+        // A triangle whose shortest side is within the boundaries' clearance is left: its
+        // points would be too (a cluster of quads a few hundredths of the mean area, shape 0.31
+        // on one image of 150).
+        let near2 = (BOUNDARY_CLEARANCE * h).powi(2);
         let sharp: Vec<TriangleId> = t
             .triangles()
-            .filter(|&f| unpaired(f) && sharp_on_boundary(t, f, SHARP_UNPAIRED_CORNER))
+            .filter(|&f| {
+                unpaired(f)
+                    && shortest_side2(t, f) >= near2
+                    && sharp_on_boundary(t, f, SHARP_UNPAIRED_CORNER)
+            })
             .collect();
         if sharp.is_empty() {
             return Ok(0);
@@ -250,11 +258,11 @@ impl RegionTriangulation {
 /// triangles' quads were most of the quads under 0.5 in shape or scaled Jacobian over 150
 /// images (287 of 372 in shape, all 59 in scaled Jacobian). Measured
 /// on those 150 images with the defaults (docs/measurements.md, session 49): quads with shape
-/// under 0.5 372 → 121, with scaled Jacobian under 0.5 59 → 26, the mean of the mean
+/// under 0.5 372 → 114, with scaled Jacobian under 0.5 59 → 24, the mean of the mean
 /// shape-and-size 0.8482 → 0.8478 (the few more quads lower the mean quad area that every quad's
 /// size is measured against); at 22.5° 172 and 36 quads, at 30° 153 and 30 with means 0.002
-/// lower, and refining every triangle to 23° instead (`--min-angle`) 199 and 28 with means 0.001
-/// lower.
+/// lower (before tiny triangles were left), and refining every triangle to 23° instead
+/// (`--min-angle`) 199 and 28 with means 0.001 lower.
 pub const SHARP_UNPAIRED_CORNER: f64 = 25.0;
 
 /// Whether triangle `f` has a corner under `degrees` with one side on a segment (with two,
@@ -303,11 +311,6 @@ pub const BOUNDARY_CLEARANCE: f64 = 0.2;
 fn clear_of_boundaries(spacing: f64) -> impl FnMut(&Triangulation, &Candidate) -> bool {
     let near2 = (BOUNDARY_CLEARANCE * spacing).powi(2);
     move |t, c| {
-        let [a, b, d] = t.triangle_points(c.bad);
-        let shortest2 = a
-            .distance_squared(b)
-            .min(b.distance_squared(d))
-            .min(d.distance_squared(a));
         let near_segment = |f: TriangleId| {
             t.triangle_edges(f).into_iter().any(|h| {
                 t.is_constrained(h)
@@ -318,9 +321,17 @@ fn clear_of_boundaries(spacing: f64) -> impl FnMut(&Triangulation, &Candidate) -
                     ) < near2
             })
         };
-        shortest2 < near2
+        shortest_side2(t, c.bad) < near2
             || !(near_segment(c.bad) || (c.containing != c.bad && near_segment(c.containing)))
     }
+}
+
+/// The squared length of the shortest side of triangle `f`.
+fn shortest_side2(t: &Triangulation, f: TriangleId) -> f64 {
+    let [a, b, d] = t.triangle_points(f);
+    a.distance_squared(b)
+        .min(b.distance_squared(d))
+        .min(d.distance_squared(a))
 }
 
 /// Refinement's area bound: that of [`DensityOptions::max_size`], and of a uniform DT'

@@ -9,8 +9,9 @@ use imesh_curves::{
 use imesh_geom::{Point, Triangulation};
 use imesh_quad::{
     adapt_within, remesh, ControlNet, DensityOptions, Element, ElementMesh, Pairing, QuadError,
-    QuadMesh, QuadOptions, RegionTriangulation, Remesh, BOUNDARY_PIECE, MAX_TRIANGLE_AREA,
-    MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN, SHARP_UNPAIRED_CORNER,
+    QuadMesh, QuadOptions, RegionTriangulation, Remesh, BOUNDARY_CLEARANCE, BOUNDARY_PIECE,
+    MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
+    SHARP_UNPAIRED_CORNER,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -872,15 +873,17 @@ fn damping_keeps_the_largest_share_that_passes() {
     assert!(shares[3] <= 0.125, "{shares:?}");
 }
 
-/// The unpaired triangles of `m` with a corner under `degrees` between two sides of which one
-/// lies on a boundary (a segment of `t`).
-fn sharp_unpaired(t: &Triangulation, m: &ElementMesh, degrees: f64) -> usize {
+/// The unpaired triangles of `m` with no side under `shortest` and a corner under `degrees`
+/// between two sides of which one lies on a boundary (a segment of `t`).
+fn sharp_unpaired(t: &Triangulation, m: &ElementMesh, degrees: f64, shortest: f64) -> usize {
     t.triangles()
         .filter(|&f| {
             let e = m.element_of_triangle[f.index()] as usize;
             let sides = t.triangle_edges(f);
             let p = t.triangle_points(f);
+            let side = |k: usize| p[k].distance_squared(p[(k + 1) % 3]).sqrt();
             matches!(m.elements[e], Element::Triangle(_))
+                && (0..3).all(|k| side(k) >= shortest)
                 && (0..3).any(|k| {
                     let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
                     let angle = (a.x * b.y - a.y * b.x).atan2(a.x * b.x + a.y * b.y);
@@ -894,23 +897,28 @@ fn sharp_unpaired(t: &Triangulation, m: &ElementMesh, degrees: f64) -> usize {
 
 #[test]
 fn unpaired_triangles_sharp_at_a_boundary_are_refined_once_more() {
+    let spacing = 4.0;
     let options = QuadOptions {
         density: DensityOptions {
-            spacing: Some(4.0),
+            spacing: Some(spacing),
             ..Default::default()
         },
         pairing: Pairing::Matching,
         ..Default::default()
+    };
+    // Triangles within the boundaries' clearance are left as they are.
+    let sharp_unpaired = |t: &Triangulation, m: &ElementMesh| {
+        sharp_unpaired(t, m, SHARP_UNPAIRED_CORNER, BOUNDARY_CLEARANCE * spacing)
     };
     let (mut before, mut after) = (0, 0);
     for name in FIXTURES {
         let c = curves(&support::fixture(name));
         let first = RegionTriangulation::new(&c.simplified.graph, &options.density).unwrap();
         let paired = ElementMesh::pair(&first.triangulation, Pairing::Matching);
-        let sharp = sharp_unpaired(&first.triangulation, &paired, SHARP_UNPAIRED_CORNER);
+        let sharp = sharp_unpaired(&first.triangulation, &paired);
         let r = run(&c, &options);
         check_mesh(&r, &c, &r.mesh.vertices);
-        let left = sharp_unpaired(&r.dt.triangulation, &r.elements, SHARP_UNPAIRED_CORNER);
+        let left = sharp_unpaired(&r.dt.triangulation, &r.elements);
         // The second refinement's points come after the first's, and are counted with them.
         let added = r.dt.triangulation.num_vertices() - first.triangulation.num_vertices();
         assert_eq!(
@@ -926,9 +934,9 @@ fn unpaired_triangles_sharp_at_a_boundary_are_refined_once_more() {
         eprintln!("{name}: {sharp} sharp unpaired triangles, {left} after, {added} points");
         (before, after) = (before + sharp, after + left);
     }
-    // New triangles are paired anew, and a few of them are left sharp in turn (a second pass
-    // measured no better: docs/measurements.md, session 49).
-    assert!(before > 0 && 2 * after < before, "{before} → {after}");
+    // New triangles are paired anew, and a few of them are left sharp in turn (213 → 49; a
+    // second pass measured no better: docs/measurements.md, session 49).
+    assert!(before > 0 && 3 * after < before, "{before} → {after}");
     // A graded DT', and a refinement to that angle already, are left as they were.
     let c = curves(&support::fixture(FIXTURES[0]));
     for density in [
