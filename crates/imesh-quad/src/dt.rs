@@ -256,13 +256,13 @@ impl RegionTriangulation {
 /// corner on a boundary sharper than this, in degrees, is refined once more
 /// ([`RegionTriangulation::open_sharp_unpaired`]), and the mesh is paired again. Such
 /// triangles' quads were most of the quads under 0.5 in shape or scaled Jacobian over 150
-/// images (287 of 372 in shape, all 59 in scaled Jacobian). Measured
-/// on those 150 images with the defaults (docs/measurements.md, session 49): quads with shape
-/// under 0.5 372 → 114, with scaled Jacobian under 0.5 59 → 24, the mean of the mean
-/// shape-and-size 0.8482 → 0.8478 (the few more quads lower the mean quad area that every quad's
-/// size is measured against); at 22.5° 172 and 36 quads, at 30° 153 and 30 with means 0.002
-/// lower (before tiny triangles were left), and refining every triangle to 23° instead
-/// (`--min-angle`) 199 and 28 with means 0.001 lower.
+/// images (287 of 372 in shape, all 59 in scaled Jacobian). Measured on those 150 images with
+/// the defaults (docs/measurements.md, session 49): quads with shape under 0.5 372 → 114, with
+/// scaled Jacobian under 0.5 59 → 24, the mean of the mean shape-and-size 0.8482 → 0.8478 (the
+/// few more quads lower the mean quad area that every quad's size is measured against); at
+/// 22.5° 172 and 36 quads, at 30° 153 and 30 with means 0.002 lower (before tiny triangles were
+/// left), and refining every triangle to 23° instead (`--min-angle`) 199 and 28 with means
+/// 0.001 lower.
 pub const SHARP_UNPAIRED_CORNER: f64 = 25.0;
 
 /// Whether triangle `f` has a corner under `degrees` with one side on a segment (with two,
