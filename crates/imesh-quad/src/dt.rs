@@ -148,14 +148,13 @@ impl RegionTriangulation {
             Some(h) => triangulation.refine_with_policy(&refine, clear_of_boundaries(h))?,
             None => triangulation.refine(&refine)?,
         };
-        graph_vertex_of.resize(triangulation.num_vertices(), NONE);
-        segment_edge.resize(triangulation.num_segments().max(segment_edge.len()), NONE);
-        let dt = Self {
+        let mut dt = Self {
             triangulation,
             segment_edge,
             graph_vertex: graph_vertex_of,
             refinement,
         };
+        dt.cover_refinement();
         Ok(dt)
     }
 
@@ -178,6 +177,18 @@ impl RegionTriangulation {
     /// The label of triangle `f`.
     pub fn label(&self, f: TriangleId) -> u32 {
         self.triangulation.label(f)
+    }
+
+    /// Extends the maps to G' over the vertices and segments refinement added, which are no G'
+    /// vertex or edge of their own ([`NONE`]).
+    fn cover_refinement(&mut self) {
+        self.graph_vertex
+            .resize(self.triangulation.num_vertices(), NONE);
+        let segments = self
+            .triangulation
+            .num_segments()
+            .max(self.segment_edge.len());
+        self.segment_edge.resize(segments, NONE);
     }
 
     /// Refines a uniform DT' (`options.spacing`) once more where pairing left a triangle whose
@@ -235,13 +246,7 @@ impl RegionTriangulation {
             &refine,
             clear_of_boundaries(h),
         )?;
-        self.graph_vertex
-            .resize(self.triangulation.num_vertices(), NONE);
-        let segments = self
-            .triangulation
-            .num_segments()
-            .max(self.segment_edge.len());
-        self.segment_edge.resize(segments, NONE);
+        self.cover_refinement();
         self.refinement = RefineReport {
             inserted: self.refinement.inserted + report.inserted,
             ..report
