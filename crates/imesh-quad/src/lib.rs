@@ -57,7 +57,10 @@ pub use dt::{
     SHARP_UNPAIRED_CORNER,
 };
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
-pub use pairing::{Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER};
+pub use pairing::{
+    Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, MIN_PINNED_CORNER_SHAPE,
+    PINNED_OBTUSE_DEG,
+};
 pub use patch::{basis, ControlNet, TRIANGLE_SLOTS};
 pub use template::{Place, Template};
 

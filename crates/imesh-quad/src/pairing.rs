@@ -16,7 +16,9 @@ pub enum Pairing {
     Greedy,
     /// Best quads first (by their worst corner), then augmenting paths that re-pair neighbours so
     /// that more triangles find a partner; no quad with a corner under 30° or over 150°
-    /// ([`MIN_MATCHING_CORNER`]): better quads, and no corner the optimiser must mend.
+    /// ([`MIN_MATCHING_CORNER`]): better quads, and no corner the optimiser must mend. Nor a
+    /// corner over 125° between two boundaries with sides too unequal for a shape of 0.5
+    /// ([`MIN_PINNED_CORNER_SHAPE`]).
     Matching,
     /// The matching with the bar at about 20.5° ([`MIN_FEWEST_CORNER`]): fewer triangles left
     /// than [`Pairing::Greedy`], some quads with flatter corners.
@@ -76,8 +78,8 @@ impl ElementMesh {
     pub fn pair(t: &Triangulation, method: Pairing) -> Self {
         let partner = match method {
             Pairing::Greedy => greedy(t),
-            Pairing::Matching => matching(t, MIN_MATCHING_CORNER),
-            Pairing::Fewest => matching(t, MIN_FEWEST_CORNER),
+            Pairing::Matching => matching(t, MIN_MATCHING_CORNER, true),
+            Pairing::Fewest => matching(t, MIN_FEWEST_CORNER, false),
         };
         Self::from_partners(t, &partner)
     }
@@ -205,12 +207,54 @@ fn strictly_convex(q: &[Point; 4]) -> bool {
 }
 
 /// The worst corner sine (scaled Jacobian) of the quad across `h` ([`quad_across`]) if it is
-/// strictly convex and that sine is at least `min_corner`.
-fn corner_sine(t: &Triangulation, h: HalfEdgeId, min_corner: f64) -> Option<f64> {
-    quad_across(t, h)
-        .filter(strictly_convex)
-        .map(|q| scaled_jacobian(&q))
-        .filter(|&w| w >= min_corner)
+/// strictly convex, that sine is at least `min_corner`, and, with `pinned`, its pinned corners
+/// are fair ([`pinned_corners_fair`]).
+fn corner_sine(t: &Triangulation, h: HalfEdgeId, min_corner: f64, pinned: bool) -> Option<f64> {
+    let q = quad_across(t, h).filter(strictly_convex)?;
+    let w = scaled_jacobian(&q);
+    (w >= min_corner && (!pinned || pinned_corners_fair(t, h, &q))).then_some(w)
+}
+
+/// [`Pairing::Matching`] forms no quad with a pinned corner (both its sides on boundaries: at
+/// a vertex of G', where nothing downstream moves either side's direction) wider than this, in
+/// degrees, unless that corner's shape is at least [`MIN_PINNED_CORNER_SHAPE`].
+pub const PINNED_OBTUSE_DEG: f64 = 125.0;
+
+/// The least shape (`2 sin θ · a b / (a² + b²)`, Verdict's quad shape at one corner of sides `a`
+/// and `b`) of a wide pinned corner ([`PINNED_OBTUSE_DEG`]) that [`Pairing::Matching`] pairs.
+///
+/// A template quad keeps its parent's corner and the ratio of its sides there (each is half its
+/// parent's side). At a corner of 145°–150° between a short boundary piece and a long one (a
+/// pixel step beside a long edge), the optimiser may slide the far ends along the boundaries
+/// to even the sides, but along a curve that turns the corner past 150° first, under the
+/// scaled Jacobian floor: the worst quads of grass (shape 0.417, 0.422) and aloe (0.359) were
+/// such corners. Left unpaired, the two triangles meeting at the corner each keep about half
+/// of it. Quads under 0.5 in shape over session 48's 150 images with the defaults, against
+/// 114 without the bar: 99 at 125° (26 against 24 under 0.5 in scaled Jacobian), 109 at 100°
+/// (25), 105 at 135° (27), and 117 at 125° with a bar of 0.55 (30); on 46 images of a seed
+/// the bar was not chosen on, 39 → 31 (scaled Jacobian 6 → 5).
+pub const MIN_PINNED_CORNER_SHAPE: f64 = 0.5;
+
+/// Whether every corner of the quad `q` across `h` ([`quad_across`]) whose two sides are
+/// constrained edges of `t`, and which is wider than [`PINNED_OBTUSE_DEG`], has a shape of at
+/// least [`MIN_PINNED_CORNER_SHAPE`].
+fn pinned_corners_fair(t: &Triangulation, h: HalfEdgeId, q: &[Point; 4]) -> bool {
+    let twin = t.twin(h);
+    // Side i of `q` (from corner i to corner i + 1), as `quad_across` orders the corners.
+    let sides = [t.next(twin), t.prev(twin), t.next(h), t.prev(h)];
+    let wide = PINNED_OBTUSE_DEG.to_radians().cos();
+    (0..4).all(|i| {
+        if !(t.is_constrained(sides[(i + 3) % 4]) && t.is_constrained(sides[i])) {
+            return true;
+        }
+        let (u, v) = (q[(i + 3) % 4] - q[i], q[(i + 1) % 4] - q[i]);
+        let (uu, vv) = (u.x * u.x + u.y * u.y, v.x * v.x + v.y * v.y);
+        let dot = u.x * v.x + u.y * v.y;
+        if dot >= wide * (uu * vv).sqrt() {
+            return true;
+        }
+        2.0 * (u.x * v.y - u.y * v.x).abs() >= MIN_PINNED_CORNER_SHAPE * (uu + vv)
+    })
 }
 
 /// The edges of `t` that have a `key`, by decreasing key, then increasing half-edge: the order
@@ -314,9 +358,9 @@ const KEEP_PAIR: f64 = 0.97;
 const MAX_AUGMENTING_DEPTH: usize = 8;
 
 /// Best quads first, then augmenting paths for the triangles left; no quad with a corner sine
-/// under `min_corner`.
-fn matching(t: &Triangulation, min_corner: f64) -> Vec<u32> {
-    let good = |h: HalfEdgeId| corner_sine(t, h, min_corner);
+/// under `min_corner`, nor, with `pinned`, an unfair pinned corner ([`pinned_corners_fair`]).
+fn matching(t: &Triangulation, min_corner: f64, pinned: bool) -> Vec<u32> {
+    let good = |h: HalfEdgeId| corner_sine(t, h, min_corner, pinned);
     // Whether the pair of `n` and its partner `p` is one an augmenting path keeps.
     let keeps = |n: TriangleId, p: u32| {
         t.triangle_edges(n).into_iter().any(|h| {

@@ -10,8 +10,8 @@ use imesh_geom::{Point, Triangulation};
 use imesh_quad::{
     adapt_within, remesh, ControlNet, DensityOptions, Element, ElementMesh, Pairing, QuadError,
     QuadMesh, QuadOptions, RegionTriangulation, Remesh, BOUNDARY_CLEARANCE, BOUNDARY_PIECE,
-    MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, POOR_SCALED_JACOBIAN,
-    SHARP_UNPAIRED_CORNER,
+    MAX_TRIANGLE_AREA, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, MIN_PINNED_CORNER_SHAPE,
+    PINNED_OBTUSE_DEG, POOR_SCALED_JACOBIAN, SHARP_UNPAIRED_CORNER,
 };
 
 // The boundary graphs of label grids, shared with imesh-curves' tests: one conversion from the
@@ -437,6 +437,23 @@ fn fewest_pairing_leaves_fewer_triangles_than_the_greedy_one() {
                 }
             }
         }
+        // Nor a matched quad a wide pinned corner with sides too unequal.
+        let t = &dt.triangulation;
+        for e in &matching.elements {
+            let Element::Quad(corners) = *e else { continue };
+            for k in 0..4 {
+                let [before, at, after] = [3, 0, 1].map(|d| corners[(k + d) % 4]);
+                if !(constrained(t, before, at) && constrained(t, at, after)) {
+                    continue;
+                }
+                let p = [before, at, after].map(|v| t.points()[v as usize]);
+                let (angle, shape) = corner_angle_and_shape(p);
+                assert!(
+                    angle <= PINNED_OBTUSE_DEG || shape >= MIN_PINNED_CORNER_SHAPE,
+                    "{name}: a pinned corner of {angle}° and shape {shape}"
+                );
+            }
+        }
         for pairing in [Pairing::Matching, Pairing::Fewest] {
             let r = run(
                 &c,
@@ -447,6 +464,61 @@ fn fewest_pairing_leaves_fewer_triangles_than_the_greedy_one() {
             );
             check_mesh(&r, &c, &r.mesh.vertices);
         }
+    }
+}
+
+/// Whether the edge between vertices `a` and `b` of `t` is a constrained edge.
+fn constrained(t: &Triangulation, a: u32, b: u32) -> bool {
+    t.edges().any(|h| {
+        let ends = [t.origin(h), t.destination(h)].map(|v| v.index() as u32);
+        (ends == [a, b] || ends == [b, a]) && t.is_constrained(h)
+    })
+}
+
+/// The angle (degrees) at `p[1]` between `p[0]` and `p[2]`, and Verdict's quad shape there:
+/// `2 |cross| / (a² + b²)`.
+fn corner_angle_and_shape(p: [Point; 3]) -> (f64, f64) {
+    let (u, v) = (p[0] - p[1], p[2] - p[1]);
+    let cross = u.x * v.y - u.y * v.x;
+    let angle = cross.abs().atan2(u.x * v.x + u.y * v.y).to_degrees();
+    (
+        angle,
+        2.0 * cross.abs() / (u.x * u.x + u.y * u.y + v.x * v.x + v.y * v.y),
+    )
+}
+
+/// A region that is one convex quad with a 145° corner between its boundaries: its two DT'
+/// triangles make that quad whatever the diagonal. With the corner's sides 1 and 3 (shape 0.34)
+/// the matching leaves the triangles (each keeps part of the corner), while the fewest-triangles
+/// pairing, which has no such bar, pairs them; with equal sides (shape 0.57) both pair them.
+#[test]
+fn matching_leaves_a_wide_pinned_corner_with_unequal_sides() {
+    let corner = 145.0f64;
+    for (far, top, paired) in [(3.0, 2.2, false), (1.0, 1.2, true)] {
+        let a = (180.0 - corner).to_radians();
+        let p = [
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(1.0 + far * a.cos(), far * a.sin()),
+            Point::new(0.2, top),
+        ];
+        let (angle, shape) = corner_angle_and_shape([p[0], p[1], p[2]]);
+        assert!((angle - corner).abs() < 1e-9);
+        assert_eq!(shape >= MIN_PINNED_CORNER_SHAPE, paired);
+        let (mut t, ids) = Triangulation::from_points(&p).unwrap();
+        for k in 0..4 {
+            t.insert_segment(ids[k], ids[(k + 1) % 4]).unwrap();
+        }
+        t.set_labels(|_| 1);
+        assert_eq!(t.num_triangles(), 2);
+        let matching = ElementMesh::pair(&t, Pairing::Matching);
+        let fewest = ElementMesh::pair(&t, Pairing::Fewest);
+        assert_eq!(fewest.unpaired, 0);
+        assert_eq!(
+            matching.unpaired,
+            if paired { 0 } else { 2 },
+            "sides 1 and {far}"
+        );
     }
 }
 

@@ -366,8 +366,10 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     // 0.9086 since thin strips' pieces are cut (0.9113 before): a strip-shaped island's
     // shorter pieces make the band outside it finer; 0.9048 since unpaired triangles sharp
     // beside a boundary are refined once more (0.9072 before: 3 points, 12 more quads, so a
-    // mean quad area 0.12 % lower, against which every lattice square scores 0.9976).
-    assert!(mean(&mri) >= 0.904);
+    // mean quad area 0.12 % lower, against which every lattice square scores 0.9976); 0.9039
+    // since the matching leaves the triangles at a wide pinned corner with unequal sides (three
+    // pairs: 6 more quads, the same mechanism).
+    assert!(mean(&mri) >= 0.903);
 }
 
 /// The lattice's second try is only a try: on grass it is finer (0.969) and makes 69 634
