@@ -117,6 +117,8 @@ struct Tip {
     next: [Option<End>; 2],
     region: u32,
     receiver: u32,
+    /// Whether the region across the other side could take the piece instead (a junction).
+    other_receiver: bool,
     /// The narrower of the chord and curve sectors (radians).
     angle: f64,
     /// Where the cut meets each side.
@@ -192,7 +194,9 @@ impl Tip {
 /// 1.5 or one `options.width` wide, the widest its edges leave room for (at most
 /// `options.max_depth` of those widths from the vertex): a new vertex on
 /// each of the two straight edges, a straight edge between them, and the triangle beyond given
-/// to the region across the first edge (the second's when the first is the domain's border).
+/// to the region across the first edge (the second's when the first is the domain's border,
+/// or when the cut, given to the first, would leave a sharp corner: a junction's tip is tried
+/// once more the other way in the next round).
 /// The curves are cut at the new vertices' projections, their ends moved onto them. Where one
 /// edge is too short for that (the region turns away at its far vertex), the cut runs from
 /// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
@@ -204,7 +208,8 @@ impl Tip {
 /// when they are closer than a width, if the piece is a quarter of a quad or less (a sliver's
 /// end). The first of these cuts whose piece holds no other vertex of the graph is made; a
 /// sector is left alone when none does. Cuts whose edges would cross are dropped, and so are
-/// cuts whose new corners would be sharp (that tip is not tried again). An edge is cut at one
+/// cuts whose new corners would be sharp, within rounding (that tip is not tried again, but
+/// for a junction's other neighbour). An edge is cut at one
 /// end per round, the sharper tip's first: a tip whose edge was taken is looked at again on
 /// the graph the round leaves, for up to four rounds. `None` when nothing was cut.
 ///
@@ -248,25 +253,26 @@ pub fn blunt_sharp_tips(
     // the border between two junctions).
     let mut blunted: Option<Blunted> = None;
     // The vertices of tips whose cut was dropped for sharp new corners: not tried again, so
-    // that the tips it kept from their edges are cut in the next round.
-    let mut refused = Vec::new();
+    // that the tips it kept from their edges are cut in the next round. A junction's tip is
+    // first tried once more with its piece given to its other neighbour.
+    let mut retries = Retries::default();
     for _ in 0..MAX_ROUNDS {
         let (graph, curves) = match &blunted {
             Some(b) => (&b.graph, b.curves.as_slice()),
             None => (g, curves),
         };
-        let Some((round, deferred)) = blunt_round(graph, curves, options, &mut refused) else {
-            break;
-        };
-        blunted = Some(match blunted {
-            Some(b) => Blunted {
-                tips: b.tips + round.tips,
-                area: b.area + round.area,
-                moved: b.moved.max(round.moved),
-                ..round
-            },
-            None => round,
-        });
+        let (round, deferred) = blunt_round(graph, curves, options, &mut retries);
+        if let Some(round) = round {
+            blunted = Some(match blunted {
+                Some(b) => Blunted {
+                    tips: b.tips + round.tips,
+                    area: b.area + round.area,
+                    moved: b.moved.max(round.moved),
+                    ..round
+                },
+                None => round,
+            });
+        }
         if !deferred {
             break;
         }
@@ -274,22 +280,42 @@ pub fn blunt_sharp_tips(
     blunted
 }
 
+/// How far under [`TipOptions::min_angle_deg`] (radians) a corner a cut makes may measure and
+/// still pass: the cuts through a side's far vertex are made to meet the other side at that
+/// angle or more, and the sectors measured afterwards, from other roundings, came out at
+/// 29.9999999999984° for 30° (on aloe, 8 of 29 cuts refused as sharp, among them the tip
+/// that held its worst scaled Jacobian, 0.406).
+const ANGLE_ROUNDING: f64 = 1e-9;
+
 /// The rounds of [`blunt_sharp_tips`] at most: each cuts at least one tip, and the tips left
 /// for a later round share an edge with one cut.
 const MAX_ROUNDS: usize = 4;
 
+/// The tips whose cut a round dropped for sharp new corners, by their vertex's point (which
+/// no cut moves).
+#[derive(Debug, Default)]
+struct Retries {
+    /// Not tried again.
+    refused: Vec<Point>,
+    /// Tried again with the piece given to the region across the tip's second side instead of
+    /// its first. A junction's tip borders two neighbours, and the piece given to one keeps the
+    /// boundary to the other: where the cut runs to a side's second vertex (a side shorter than
+    /// the cut is wide), that boundary meets the cut at a sharp corner, which the neighbour
+    /// across that side, taking the side whole, does not have (aloe: 8 of the tips refused).
+    swapped: Vec<Point>,
+}
+
 /// One round of [`blunt_sharp_tips`]: the graph with every tip cut whose edges no sharper
-/// tip's cut takes, and whether a tip was left for that reason. Tips at the points in
-/// `refused` are left; those whose cut is dropped for sharp new corners are added to it.
-/// `None` when nothing was cut.
+/// tip's cut takes (`None` when nothing was cut), and whether a tip was left for that reason
+/// or for another try ([`Retries`]).
 fn blunt_round(
     g: &CurveGraph,
     curves: &[CubicBezier],
     options: &TipOptions,
-    refused: &mut Vec<Point>,
-) -> Option<(Blunted, bool)> {
-    let mut tips = sharp_tips(g, curves, options);
-    tips.retain(|cut| !refused.contains(&g.point(cut.tip.vertex)));
+    retries: &mut Retries,
+) -> (Option<Blunted>, bool) {
+    let mut tips = sharp_tips(g, curves, options, &retries.swapped);
+    tips.retain(|cut| !retries.refused.contains(&g.point(cut.tip.vertex)));
     // The sharpest first; an edge is cut at one end only.
     tips.sort_by(|a, b| a.tip.angle.total_cmp(&b.tip.angle));
     let mut used = vec![false; g.edges().len()];
@@ -306,11 +332,12 @@ fn blunt_round(
         cuts.push(cut);
     }
     // A cut whose new corners would be sharp themselves (a curve turning back across its
-    // chord near the cut) is dropped, and the rest made again.
-    let min = options.min_angle_deg.to_radians();
+    // chord near the cut) is dropped, and the rest made again. A cut made to meet a side at
+    // exactly the bar ([`through_depth`]) measures within rounding of it: not sharp.
+    let min = options.min_angle_deg.to_radians() - ANGLE_ROUNDING;
     loop {
         if cuts.is_empty() {
-            return None;
+            return (None, deferred);
         }
         let (blunted, ends) = match cut_off(g, curves, &cuts) {
             Ok(made) => made,
@@ -322,7 +349,7 @@ fn blunt_round(
                 }
                 continue;
             }
-            Err(_) => return None,
+            Err(_) => return (None, false),
         };
         let sharp: Vec<usize> = (0..cuts.len())
             .filter(|&i| {
@@ -334,10 +361,16 @@ fn blunt_round(
             })
             .collect();
         if sharp.is_empty() {
-            return Some((blunted, deferred));
+            return (Some(blunted), deferred);
         }
         for &i in sharp.iter().rev() {
-            refused.push(g.point(cuts[i].tip.vertex));
+            let at = g.point(cuts[i].tip.vertex);
+            if cuts[i].tip.other_receiver && !retries.swapped.contains(&at) {
+                retries.swapped.push(at);
+                deferred = true;
+            } else {
+                retries.refused.push(at);
+            }
             cuts.remove(i);
         }
     }
@@ -522,7 +555,12 @@ fn sectors(g: &CurveGraph, curves: &[CubicBezier], v: u32, reach: f64) -> Vec<Se
 }
 
 /// Every sector of `g` narrower than the options' angle that may be cut, with its cut.
-fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<Cut> {
+fn sharp_tips(
+    g: &CurveGraph,
+    curves: &[CubicBezier],
+    options: &TipOptions,
+    swapped: &[Point],
+) -> Vec<Cut> {
     let min = options.min_angle_deg.to_radians();
     let mut tips = Vec::new();
     for v in 0..g.points().len() as u32 {
@@ -537,11 +575,14 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
             if region == OUTSIDE || right[1] != region {
                 continue;
             }
-            let receiver = match (left[1], right[0]) {
-                (s, _) if s != OUTSIDE && s != region => s,
-                (_, s) if s != OUTSIDE && s != region => s,
-                _ => continue,
+            // The region across the first side, else the second's ([`Retries::swapped`]:
+            // the second's first).
+            let across = [left[1], right[0]].map(|s| (s != OUTSIDE && s != region).then_some(s));
+            let receiver = match (across, swapped.contains(&p)) {
+                ([_, Some(s)], true) | ([Some(s), _], _) | ([None, Some(s)], _) => s,
+                ([None, None], _) => continue,
             };
+            let other_receiver = matches!(across, [Some(a), Some(b)] if a != b);
             // The region's boundary one edge further on each side (not back at the tip).
             let next = [0, 1].map(|k| {
                 let e = ends[k];
@@ -620,6 +661,7 @@ fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> V
                 next,
                 region,
                 receiver,
+                other_receiver,
                 angle,
                 cut,
             };
@@ -1013,6 +1055,98 @@ mod tests {
         assert!(sectors_at(&b.graph, 0).iter().all(|&(_, a)| a > 30.0));
     }
 
+    /// A junction's wedge (region 1) of 26.6° on the pixel lattice, as on aloe: its sides 2 and
+    /// 2.2 px to their first vertices, where one turns up-left at 45° and the other runs on,
+    /// between region 2 across its first side and region 3 across its second. The cut runs
+    /// from the first side's vertex to the second side's next one; given to region 2, the
+    /// piece would meet the boundary of region 3 it keeps there at 18.4°, so that cut was
+    /// refused and the tip left whole. Given to region 3, which takes the second side whole,
+    /// it is made: the junction is gone from region 1 and no sector is left under 30°.
+    #[test]
+    fn a_junction_tip_is_given_to_the_neighbour_that_takes_its_short_side() {
+        let points: Vec<Point> = [
+            (0.0, 0.0),  // 0: the tip
+            (-2.0, 0.0), // 1, 2: its second side
+            (-3.0, -1.0),
+            (-2.0, 1.0), // 3, 4: its first side
+            (-11.0, 8.0),
+            (-30.0, 8.0), // 5, 6: region 1 meets the frame
+            (-30.0, -1.0),
+            (30.0, 2.0),  // 7: the boundary of regions 2 and 3 meets the frame
+            (30.0, 30.0), // 8..=11: the frame's corners
+            (-30.0, 30.0),
+            (-30.0, -30.0),
+            (30.0, -30.0),
+        ]
+        .map(Point::from)
+        .to_vec();
+        let regions: [(u32, Vec<usize>); 3] = [
+            (1, vec![0, 3, 4, 5, 6, 2, 1]),
+            (2, vec![0, 7, 8, 9, 5, 4, 3]),
+            (3, vec![0, 1, 2, 6, 10, 11, 7]),
+        ];
+        let label_at = |q: Point| {
+            regions
+                .iter()
+                .find(|(_, ring)| {
+                    let n = ring.len();
+                    winds_around(
+                        (0..n).map(|k| (points[ring[k]], points[ring[(k + 1) % n]])),
+                        q,
+                    )
+                })
+                .map_or(OUTSIDE, |r| r.0)
+        };
+        let pairs = [
+            (0, 1),
+            (1, 2),
+            (2, 6),
+            (6, 5),
+            (5, 4),
+            (4, 3),
+            (3, 0),
+            (0, 7),
+            (7, 8),
+            (8, 9),
+            (9, 5),
+            (6, 10),
+            (10, 11),
+            (11, 7),
+        ];
+        let edges: Vec<GraphEdge> = pairs
+            .iter()
+            .map(|&(a, b)| {
+                let (p, q) = (points[a], points[b]);
+                let (mid, d) = (p + (q - p) * 0.5, (q - p) * (1e-3 / norm(q - p)));
+                let left = Point::new(-d.y, d.x);
+                GraphEdge {
+                    ends: [a as u32, b as u32],
+                    labels: [label_at(mid + left), label_at(mid - left)],
+                }
+            })
+            .collect();
+        let g = CurveGraph::new(points, edges).unwrap();
+        let tip = sectors_at(&g, 0);
+        assert!(
+            tip.iter()
+                .any(|&(l, a)| l == 1 && (a - 26.565).abs() < 1e-3),
+            "{tip:?}"
+        );
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        assert!(sectors_at(&b.graph, 0).iter().all(|&(l, _)| l != 1));
+        for v in 0..b.graph.points().len() as u32 {
+            for (label, angle) in sectors_at(&b.graph, v) {
+                assert!(angle > 30.0 - 1e-6, "{v}: {label} {angle}");
+            }
+        }
+        let (before, after) = (areas(&g), areas(&b.graph));
+        assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
+        assert!((after[&3] - before[&3] - b.area).abs() < 1e-9);
+        assert!((before[&2] - after[&2]).abs() < 1e-9);
+    }
+
     /// Where one side of the tip is the domain's border, the tip goes to the region across the
     /// other side, and the border keeps its line.
     #[test]
@@ -1066,7 +1200,7 @@ mod tests {
         curves[0] = CubicBezier::new([a, Point::new(8.0, -120.0), Point::new(13.0, 120.0), b]);
         // The tip is still sharp and cut, but the cut's corner at the lower side would be
         // sharp too.
-        assert_eq!(sharp_tips(&g, &curves, &options).len(), 1);
+        assert_eq!(sharp_tips(&g, &curves, &options, &[]).len(), 1);
         assert!(blunt_sharp_tips(&g, &curves, &options).is_none());
     }
 
@@ -1144,6 +1278,50 @@ mod tests {
         let run = 3.0 * 20f64.to_radians().cos()
             + (4.0 - (3.0 * 20f64.to_radians().sin()).powi(2)).sqrt();
         assert!((b.area - 0.5 * 3.0 * run * 20f64.to_radians().sin()).abs() < 1e-9);
+    }
+
+    /// The tip of a strip 2 px thick: its upper side rises to the strip's height and the
+    /// region runs on along it, parallel to the lower side. The cut from the upper side's end
+    /// meets the lower side at exactly the bar, 30°, a cut of the widest width (4 px, twice the
+    /// strip), which leaves the strip 30° at both its ends by construction (the strip's sides
+    /// are parallel), and the sectors measured afterwards give those as 30° within rounding
+    /// either way (on aloe, 29.9999999999984°). Such a cut is made at every tip angle and turn
+    /// of the frame, and leaves no sector under 30° by more than the rounding.
+    #[test]
+    fn a_cut_meeting_a_side_at_exactly_the_bar_is_made() {
+        let options = two_px();
+        let mut exact = 0;
+        for angle in [18.0, 20.0, 22.0, 24.0, 26.0, 28.0] {
+            let a = Point::new(2.0 / f64::to_radians(angle).tan(), 2.0);
+            for turn in (0..36).map(|k| f64::from(k) * 10.0 + 3.0) {
+                let outline = [
+                    Point::new(0.0, 0.0),
+                    Point::new(30.0, 0.0),
+                    Point::new(30.0, 2.0),
+                    a,
+                ];
+                let g = in_frame(&outline, turn).unwrap();
+                let b = cut_once(&g, &options);
+                let new = g.points().len() as u32;
+                assert_eq!(
+                    b.graph.points().len(),
+                    g.points().len() + 1,
+                    "{angle}° {turn}°"
+                );
+                let cut = b.graph.edges().last().unwrap();
+                let [p, q] = cut.ends.map(|v| b.graph.point(v));
+                if (norm(q - p) - 4.0).abs() < 1e-9 {
+                    exact += 1;
+                }
+                for v in [3, new] {
+                    for (label, sector) in sectors_at(&b.graph, v) {
+                        assert!(sector > 30.0 - 1e-6, "{angle}° {turn}°: {label} {sector}");
+                    }
+                }
+            }
+        }
+        // The widest cut, at exactly 30°, where the rounding let it be made at all.
+        assert!(exact > 0);
     }
 
     /// A 12° tip whose upper side ends 2.45 px over the lower one (where the region turns up):
