@@ -1,6 +1,6 @@
 //! The quad stage on the fixtures' simplified boundary graphs.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use imesh_classify::LabelGrid;
 use imesh_curves::{
@@ -439,11 +439,13 @@ fn fewest_pairing_leaves_fewer_triangles_than_the_greedy_one() {
         }
         // Nor a matched quad a wide pinned corner with sides too unequal.
         let t = &dt.triangulation;
+        let constrained = constrained_edges(t);
+        let on_boundary = |a: u32, b: u32| constrained.contains(&[a.min(b), a.max(b)]);
         for e in &matching.elements {
             let Element::Quad(corners) = *e else { continue };
             for k in 0..4 {
                 let [before, at, after] = [3, 0, 1].map(|d| corners[(k + d) % 4]);
-                if !(constrained(t, before, at) && constrained(t, at, after)) {
+                if !(on_boundary(before, at) && on_boundary(at, after)) {
                     continue;
                 }
                 let p = [before, at, after].map(|v| t.points()[v as usize]);
@@ -467,12 +469,15 @@ fn fewest_pairing_leaves_fewer_triangles_than_the_greedy_one() {
     }
 }
 
-/// Whether the edge between vertices `a` and `b` of `t` is a constrained edge.
-fn constrained(t: &Triangulation, a: u32, b: u32) -> bool {
-    t.edges().any(|h| {
-        let ends = [t.origin(h), t.destination(h)].map(|v| v.index() as u32);
-        (ends == [a, b] || ends == [b, a]) && t.is_constrained(h)
-    })
+/// The constrained edges of `t`, each as its two vertex ids, the smaller first.
+fn constrained_edges(t: &Triangulation) -> HashSet<[u32; 2]> {
+    t.edges()
+        .filter(|&h| t.is_constrained(h))
+        .map(|h| {
+            let (a, b) = (t.origin(h).index() as u32, t.destination(h).index() as u32);
+            [a.min(b), a.max(b)]
+        })
+        .collect()
 }
 
 /// The angle (degrees) at `p[1]` between `p[0]` and `p[2]`, and Verdict's quad shape there:
