@@ -117,8 +117,6 @@ struct Tip {
     next: [Option<End>; 2],
     region: u32,
     receiver: u32,
-    /// Whether the region across the other side could take the piece instead (a junction).
-    other_receiver: bool,
     /// The narrower of the chord and curve sectors (radians).
     angle: f64,
     /// Where the cut meets each side.
@@ -132,6 +130,38 @@ struct Cut {
     tip: Tip,
     ends: [Point; 2],
     outline: Vec<Point>,
+}
+
+/// The cuts a sharp tip could take, in the order they are tried ([`sharp_tips`]): each cut
+/// with its piece given to the region across the tip's first side, then to the one across its
+/// second (a junction's other neighbour), before the next cut.
+#[derive(Clone, Debug)]
+struct TipCuts {
+    tries: Vec<Tip>,
+    /// The first of `tries` not yet tried.
+    next: usize,
+}
+
+impl TipCuts {
+    /// The next of the tries whose piece is sound and whose edges no other cut takes (`used`,
+    /// per edge of `g`; none when `used` is empty), marked as tried.
+    fn next_sound(&mut self, g: &CurveGraph, used: &[bool]) -> Option<Cut> {
+        while let Some(&tip) = self.tries.get(self.next) {
+            self.next += 1;
+            if !used.is_empty() && tip.edges().any(|e| used[e as usize]) {
+                continue;
+            }
+            let (outline, [i, j], on) = tip.piece(g);
+            if sound_piece(g, &on, &outline, [i, j]) {
+                return Some(Cut {
+                    tip,
+                    ends: [outline[i], outline[j]],
+                    outline,
+                });
+            }
+        }
+        None
+    }
 }
 
 /// Where a tip's cut meets one of its sides.
@@ -194,9 +224,7 @@ impl Tip {
 /// 1.5 or one `options.width` wide, the widest its edges leave room for (at most
 /// `options.max_depth` of those widths from the vertex): a new vertex on
 /// each of the two straight edges, a straight edge between them, and the triangle beyond given
-/// to the region across the first edge (the second's when the first is the domain's border,
-/// or when the cut, given to the first, would leave a sharp corner: a junction's tip is tried
-/// once more the other way in the next round).
+/// to the region across the first edge (the second's when the first is the domain's border).
 /// The curves are cut at the new vertices' projections, their ends moved onto them. Where one
 /// edge is too short for that (the region turns away at its far vertex), the cut runs from
 /// that vertex to a new one on the other edge, two, 1.5 or one width away and meeting it at
@@ -207,9 +235,10 @@ impl Tip {
 /// the cut then at most two widths long; failing all those, between the first vertices even
 /// when they are closer than a width, if the piece is a quarter of a quad or less (a sliver's
 /// end). The first of these cuts whose piece holds no other vertex of the graph is made; a
-/// sector is left alone when none does. Cuts whose edges would cross are dropped, and so are
-/// cuts whose new corners would be sharp, within rounding (that tip is not tried again, but
-/// for a junction's other neighbour). An edge is cut at one
+/// sector is left alone when none does. Cuts whose edges would cross are dropped. A cut whose
+/// new corners would be sharp, within rounding, gives way to the same cut with the piece given
+/// to a junction's other neighbour, then to the next of these cuts, in the same round; a tip
+/// none of whose cuts passes is left, and not tried again. An edge is cut at one
 /// end per round, the sharper tip's first: a tip whose edge was taken is looked at again on
 /// the graph the round leaves, for up to four rounds. `None` when nothing was cut.
 ///
@@ -252,9 +281,8 @@ pub fn blunt_sharp_tips(
     // again on the graph that cut leaves (a long edge between two sharp tips, a sliver along
     // the border between two junctions).
     let mut blunted: Option<Blunted> = None;
-    // The vertices of tips whose cut was dropped for sharp new corners: not tried again, so
-    // that the tips it kept from their edges are cut in the next round. A junction's tip is
-    // first tried once more with its piece given to its other neighbour.
+    // The vertices of tips whose every cut was dropped for sharp new corners: not tried
+    // again, so that the tips they kept from their edges are cut in the next round.
     let mut retries = Retries::default();
     for _ in 0..MAX_ROUNDS {
         let (graph, curves) = match &blunted {
@@ -291,37 +319,30 @@ const ANGLE_ROUNDING: f64 = 1e-9;
 /// for a later round share an edge with one cut.
 const MAX_ROUNDS: usize = 4;
 
-/// The tips whose cut a round dropped for sharp new corners, by their vertex's point (which
-/// no cut moves).
+/// The tips whose every cut a round dropped for sharp new corners, by their vertex's point
+/// (which no cut moves): not tried again.
 #[derive(Debug, Default)]
 struct Retries {
-    /// Not tried again.
     refused: Vec<Point>,
-    /// Tried again with the piece given to the region across the tip's second side instead of
-    /// its first. A junction's tip borders two neighbours, and the piece given to one keeps the
-    /// boundary to the other: where the cut runs to a side's second vertex (a side shorter than
-    /// the cut is wide), that boundary meets the cut at a sharp corner, which the neighbour
-    /// across that side, taking the side whole, does not have (aloe: 8 of the tips refused).
-    swapped: Vec<Point>,
 }
 
 /// One round of [`blunt_sharp_tips`]: the graph with every tip cut whose edges no sharper
-/// tip's cut takes (`None` when nothing was cut), and whether a tip was left for that reason
-/// or for another try ([`Retries`]).
+/// tip's cut takes (`None` when nothing was cut), and whether a tip was left for that reason.
 fn blunt_round(
     g: &CurveGraph,
     curves: &[CubicBezier],
     options: &TipOptions,
     retries: &mut Retries,
 ) -> (Option<Blunted>, bool) {
-    let mut tips = sharp_tips(g, curves, options, &retries.swapped);
-    tips.retain(|cut| !retries.refused.contains(&g.point(cut.tip.vertex)));
+    let mut tips = sharp_tips(g, curves, options);
+    tips.retain(|(cut, _)| !retries.refused.contains(&g.point(cut.tip.vertex)));
     // The sharpest first; an edge is cut at one end only.
-    tips.sort_by(|a, b| a.tip.angle.total_cmp(&b.tip.angle));
+    tips.sort_by(|a, b| a.0.tip.angle.total_cmp(&b.0.tip.angle));
     let mut used = vec![false; g.edges().len()];
     let mut cuts = Vec::new();
+    let mut others = Vec::new();
     let mut deferred = false;
-    for cut in tips {
+    for (cut, tries) in tips {
         if cut.tip.edges().any(|e| used[e as usize]) {
             deferred = true;
             continue;
@@ -330,10 +351,13 @@ fn blunt_round(
             used[e as usize] = true;
         }
         cuts.push(cut);
+        others.push(tries);
     }
     // A cut whose new corners would be sharp themselves (a curve turning back across its
-    // chord near the cut) is dropped, and the rest made again. A cut made to meet a side at
-    // exactly the bar ([`through_depth`]) measures within rounding of it: not sharp.
+    // chord near the cut, a side running on from the cut's end at the tip's angle) gives way
+    // to the tip's next cut, and the cuts are made again; a tip none of whose cuts passes is
+    // left. A cut made to meet a side at exactly the bar ([`through_depth`]) measures within
+    // rounding of it: not sharp.
     let min = options.min_angle_deg.to_radians() - ANGLE_ROUNDING;
     loop {
         if cuts.is_empty() {
@@ -346,6 +370,7 @@ fn blunt_round(
             Err(crossing) if !crossing.is_empty() => {
                 for &i in crossing.iter().rev() {
                     cuts.remove(i);
+                    others.remove(i);
                 }
                 continue;
             }
@@ -364,14 +389,22 @@ fn blunt_round(
             return (Some(blunted), deferred);
         }
         for &i in sharp.iter().rev() {
-            let at = g.point(cuts[i].tip.vertex);
-            if cuts[i].tip.other_receiver && !retries.swapped.contains(&at) {
-                retries.swapped.push(at);
-                deferred = true;
-            } else {
-                retries.refused.push(at);
+            for e in cuts[i].tip.edges() {
+                used[e as usize] = false;
             }
-            cuts.remove(i);
+            match others[i].next_sound(g, &used) {
+                Some(next) => {
+                    for e in next.tip.edges() {
+                        used[e as usize] = true;
+                    }
+                    cuts[i] = next;
+                }
+                None => {
+                    retries.refused.push(g.point(cuts[i].tip.vertex));
+                    cuts.remove(i);
+                    others.remove(i);
+                }
+            }
         }
     }
 }
@@ -555,12 +588,7 @@ fn sectors(g: &CurveGraph, curves: &[CubicBezier], v: u32, reach: f64) -> Vec<Se
 }
 
 /// Every sector of `g` narrower than the options' angle that may be cut, with its cut.
-fn sharp_tips(
-    g: &CurveGraph,
-    curves: &[CubicBezier],
-    options: &TipOptions,
-    swapped: &[Point],
-) -> Vec<Cut> {
+fn sharp_tips(g: &CurveGraph, curves: &[CubicBezier], options: &TipOptions) -> Vec<(Cut, TipCuts)> {
     let min = options.min_angle_deg.to_radians();
     let mut tips = Vec::new();
     for v in 0..g.points().len() as u32 {
@@ -575,14 +603,17 @@ fn sharp_tips(
             if region == OUTSIDE || right[1] != region {
                 continue;
             }
-            // The region across the first side, else the second's ([`Retries::swapped`]:
-            // the second's first).
+            // The region across the first side, then the second's (a junction's tip borders
+            // two neighbours, and the piece given to one keeps the boundary to the other:
+            // where the cut runs to a side's far vertex, that boundary can meet the cut at a
+            // sharp corner, which the neighbour across that side, taking the side whole, does
+            // not have; aloe: 8 of its tips).
             let across = [left[1], right[0]].map(|s| (s != OUTSIDE && s != region).then_some(s));
-            let receiver = match (across, swapped.contains(&p)) {
-                ([_, Some(s)], true) | ([Some(s), _], _) | ([None, Some(s)], _) => s,
-                ([None, None], _) => continue,
+            let receivers = match across {
+                [Some(a), Some(b)] if a != b => vec![a, b],
+                [Some(s), _] | [None, Some(s)] => vec![s],
+                [None, None] => continue,
             };
-            let other_receiver = matches!(across, [Some(a), Some(b)] if a != b);
             // The region's boundary one edge further on each side (not back at the tip).
             let next = [0, 1].map(|k| {
                 let e = ends[k];
@@ -655,25 +686,32 @@ fn sharp_tips(
                 whole([second; 2], false),
                 whole([first; 2], true),
             ];
-            let tip = |cut| Tip {
-                vertex: v,
-                ends,
-                next,
-                region,
-                receiver,
-                other_receiver,
-                angle,
-                cut,
-            };
-            let sound = candidates.into_iter().flatten().map(tip).find_map(|tip| {
-                let (outline, [i, j], on) = tip.piece(g);
-                sound_piece(g, &on, &outline, [i, j]).then(|| Cut {
-                    tip,
-                    ends: [outline[i], outline[j]],
-                    outline,
+            // The last candidate can repeat the third (between the first vertices).
+            let mut cuts: Vec<[CutEnd; 2]> = Vec::with_capacity(candidates.len());
+            for cut in candidates.into_iter().flatten() {
+                if !cuts.contains(&cut) {
+                    cuts.push(cut);
+                }
+            }
+            let tries = cuts
+                .into_iter()
+                .flat_map(|cut| {
+                    receivers.iter().map(move |&receiver| Tip {
+                        vertex: v,
+                        ends,
+                        next,
+                        region,
+                        receiver,
+                        angle,
+                        cut,
+                    })
                 })
-            });
-            tips.extend(sound);
+                .collect();
+            // The first sound one is cut; the others wait until a cut proves sharp.
+            let mut tries = TipCuts { tries, next: 0 };
+            if let Some(cut) = tries.next_sound(g, &[]) {
+                tips.push((cut, tries));
+            }
         }
     }
     tips
@@ -1080,23 +1118,11 @@ mod tests {
         ]
         .map(Point::from)
         .to_vec();
-        let regions: [(u32, Vec<usize>); 3] = [
+        let regions = [
             (1, vec![0, 3, 4, 5, 6, 2, 1]),
             (2, vec![0, 7, 8, 9, 5, 4, 3]),
             (3, vec![0, 1, 2, 6, 10, 11, 7]),
         ];
-        let label_at = |q: Point| {
-            regions
-                .iter()
-                .find(|(_, ring)| {
-                    let n = ring.len();
-                    winds_around(
-                        (0..n).map(|k| (points[ring[k]], points[ring[(k + 1) % n]])),
-                        q,
-                    )
-                })
-                .map_or(OUTSIDE, |r| r.0)
-        };
         let pairs = [
             (0, 1),
             (1, 2),
@@ -1113,19 +1139,7 @@ mod tests {
             (10, 11),
             (11, 7),
         ];
-        let edges: Vec<GraphEdge> = pairs
-            .iter()
-            .map(|&(a, b)| {
-                let (p, q) = (points[a], points[b]);
-                let (mid, d) = (p + (q - p) * 0.5, (q - p) * (1e-3 / norm(q - p)));
-                let left = Point::new(-d.y, d.x);
-                GraphEdge {
-                    ends: [a as u32, b as u32],
-                    labels: [label_at(mid + left), label_at(mid - left)],
-                }
-            })
-            .collect();
-        let g = CurveGraph::new(points, edges).unwrap();
+        let g = labelled_graph(points, &regions, &pairs);
         let tip = sectors_at(&g, 0);
         assert!(
             tip.iter()
@@ -1145,6 +1159,107 @@ mod tests {
         assert!((before[&1] - after[&1] - b.area).abs() < 1e-9);
         assert!((after[&3] - before[&3] - b.area).abs() < 1e-9);
         assert!((before[&2] - after[&2]).abs() < 1e-9);
+    }
+
+    /// The graph of `pairs` of `points`, each edge labelled with the regions (`regions`: a label
+    /// and its counter-clockwise ring of point indices) on its left and right.
+    fn labelled_graph(
+        points: Vec<Point>,
+        regions: &[(u32, Vec<usize>)],
+        pairs: &[(usize, usize)],
+    ) -> CurveGraph {
+        let label_at = |q: Point| {
+            regions
+                .iter()
+                .find(|(_, ring)| {
+                    let n = ring.len();
+                    winds_around(
+                        (0..n).map(|k| (points[ring[k]], points[ring[(k + 1) % n]])),
+                        q,
+                    )
+                })
+                .map_or(OUTSIDE, |r| r.0)
+        };
+        let edges: Vec<GraphEdge> = pairs
+            .iter()
+            .map(|&(a, b)| {
+                let (p, q) = (points[a], points[b]);
+                let (mid, d) = (p + (q - p) * 0.5, (q - p) * (1e-3 / norm(q - p)));
+                let left = Point::new(-d.y, d.x);
+                GraphEdge {
+                    ends: [a as u32, b as u32],
+                    labels: [label_at(mid + left), label_at(mid - left)],
+                }
+            })
+            .collect();
+        CurveGraph::new(points, edges).unwrap()
+    }
+
+    /// A junction's 26.6° wedge (region 1) at the end of a strip a pixel thick, as on aloe
+    /// (its worst scaled Jacobian, 0.447): its sides 2.2 and 2 px to their first vertices, a
+    /// pixel apart, the strip running on between region 2 above and region 3 below. The first
+    /// cuts tried run from one side's first vertex to the other side's next one, and meet the
+    /// side running on at 26.6° or 18.4°, whichever neighbour takes the piece; the cut
+    /// between the first vertices, tried after them, leaves no corner under 30°.
+    #[test]
+    fn a_tip_whose_first_cuts_are_sharp_takes_a_later_one() {
+        let points: Vec<Point> = [
+            (0.0, 0.0), // 0: the tip
+            (2.0, 0.0), // 1, 2: its lower side, then the strip's lower boundary
+            (4.0, -1.0),
+            (30.0, -1.0), // 3, 4: the strip meets the frame
+            (30.0, 0.0),
+            (4.0, 0.0), // 5, 6: the strip's upper boundary, then the tip's upper side
+            (2.0, 1.0),
+            (30.0, 30.0), // 7..=11: the frame and the boundary of regions 2 and 3
+            (-30.0, 30.0),
+            (-30.0, 0.0),
+            (-30.0, -30.0),
+            (30.0, -30.0),
+        ]
+        .map(Point::from)
+        .to_vec();
+        let regions = [
+            (1, vec![0, 1, 2, 3, 4, 5, 6]),
+            (2, vec![9, 0, 6, 5, 4, 7, 8]),
+            (3, vec![9, 10, 11, 3, 2, 1, 0]),
+        ];
+        let pairs = [
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 4),
+            (4, 5),
+            (5, 6),
+            (6, 0),
+            (9, 0),
+            (4, 7),
+            (7, 8),
+            (8, 9),
+            (9, 10),
+            (10, 11),
+            (11, 3),
+        ];
+        let g = labelled_graph(points, &regions, &pairs);
+        assert!(sectors_at(&g, 0)
+            .iter()
+            .any(|&(l, a)| l == 1 && (a - 26.565).abs() < 1e-3));
+        let b = blunt_sharp_tips(&g, &straight(&g), &two_px()).unwrap();
+        assert_eq!(b.tips, 1);
+        assert!(b.graph.crossing().is_none());
+        // Cut between the first vertices: the piece is the triangle (0, 1, 6), 1 px².
+        assert!((b.area - 1.0).abs() < 1e-9);
+        assert!(b.graph.edges().iter().any(|e| {
+            let mut ends = e.ends;
+            ends.sort_unstable();
+            ends == [1, 6]
+        }));
+        assert!(sectors_at(&b.graph, 0).iter().all(|&(l, _)| l != 1));
+        for v in 0..b.graph.points().len() as u32 {
+            for (label, angle) in sectors_at(&b.graph, v) {
+                assert!(angle > 30.0 - 1e-6, "{v}: {label} {angle}");
+            }
+        }
     }
 
     /// Where one side of the tip is the domain's border, the tip goes to the region across the
@@ -1200,7 +1315,7 @@ mod tests {
         curves[0] = CubicBezier::new([a, Point::new(8.0, -120.0), Point::new(13.0, 120.0), b]);
         // The tip is still sharp and cut, but the cut's corner at the lower side would be
         // sharp too.
-        assert_eq!(sharp_tips(&g, &curves, &options, &[]).len(), 1);
+        assert_eq!(sharp_tips(&g, &curves, &options).len(), 1);
         assert!(blunt_sharp_tips(&g, &curves, &options).is_none());
     }
 
