@@ -428,22 +428,29 @@ fn matching(t: &Triangulation, min_corner: f64, pinned: bool, even_sizes: bool) 
         }
         // Flip the path back from its free end: each free-side triangle takes the neighbour the
         // search reached from it, and its old partner is re-paired the same way, up to `start`.
-        let Some(mut n) = end else { continue };
-        loop {
-            let f = parent[n.index()];
-            let old = partner[f as usize];
-            partner[f as usize] = n.index() as u32;
-            partner[n.index()] = f;
-            if f == start.index() as u32 || old == NONE {
-                break;
-            }
-            n = TriangleId::new(old);
-        }
+        let Some(n) = end else { continue };
+        flip_path(&mut partner, &parent, start, n);
     }
     if even_sizes {
         move_unpaired_to_mean_size(t, &mut partner, good, keeps);
     }
     partner
+}
+
+/// Re-pairs an alternating path of a search from `start` back from its free end `n`: each
+/// free-side triangle (`parent` of the triangle the search reached from it) takes that
+/// triangle, and its old partner is re-paired the same way, up to `start`.
+fn flip_path(partner: &mut [u32], parent: &[u32], start: TriangleId, mut n: TriangleId) {
+    loop {
+        let f = parent[n.index()];
+        let old = partner[f as usize];
+        partner[f as usize] = n.index() as u32;
+        partner[n.index()] = f;
+        if f == start.index() as u32 || old == NONE {
+            break;
+        }
+        n = TriangleId::new(old);
+    }
 }
 
 /// The signed area of triangle `f` (positive: counter-clockwise).
@@ -563,20 +570,11 @@ fn move_unpaired_to_mean_size(
             }
         }
         // Flip the path back from its end, as an augmenting path, its last partner left.
-        let Some((_, mut n)) = best else { continue };
+        let Some((_, n)) = best else { continue };
         let p = partner[n.index()];
         partner[p as usize] = NONE;
         partner[n.index()] = NONE;
-        loop {
-            let f = parent[n.index()];
-            let old = partner[f as usize];
-            partner[f as usize] = n.index() as u32;
-            partner[n.index()] = f;
-            if f == start.index() as u32 || old == NONE {
-                break;
-            }
-            n = TriangleId::new(old);
-        }
+        flip_path(partner, &parent, start, n);
     }
 }
 
