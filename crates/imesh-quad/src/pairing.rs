@@ -432,7 +432,7 @@ fn matching(t: &Triangulation, min_corner: f64, pinned: bool, even_sizes: bool) 
         flip_path(&mut partner, &parent, start, n);
     }
     if even_sizes {
-        move_unpaired_to_mean_size(t, &mut partner, good, keeps);
+        move_unpaired_to_mean_size(t, &mut partner, good);
     }
     partner
 }
@@ -491,8 +491,9 @@ const EVEN_SIZE_PAIR_SLACK: f64 = 0.1;
 /// triangle that refinement made small against a short boundary piece, its quads are half the
 /// mean area or less, under 0.25 (most of the quads under 0.25 on the label fixtures: coffee
 /// 306 of 420 under half the mean area). A path's pairs are the matching's own kind (`good`:
-/// no corner under its bar), none undoing a pair it keeps (`keeps`: the lattice's squares) nor
-/// more than [`EVEN_SIZE_PAIR_SLACK`] worse than the pair it undoes, and the triangle left has
+/// no corner under its bar), none undoing a pair the matching keeps ([`KEEP_PAIR`]: the
+/// lattice's squares) nor more than [`EVEN_SIZE_PAIR_SLACK`] worse than the pair it undoes, and
+/// the triangle left has
 /// a smallest corner no sharper than the one it replaces has, or than 30°: a sharp triangle's
 /// quads keep its corner. Measured with the defaults: mean shape-and-size higher on all nine
 /// fixtures (all but aloe; mean of them 0.83747 → 0.83851), the mean of 150 images' means
@@ -504,7 +505,6 @@ fn move_unpaired_to_mean_size(
     t: &Triangulation,
     partner: &mut [u32],
     good: impl Fn(HalfEdgeId) -> Option<f64>,
-    keeps: impl Fn(TriangleId, u32) -> bool,
 ) {
     let (mut area, mut unpaired, mut count) = (0.0, Vec::new(), 0usize);
     for f in t.triangles() {
@@ -548,12 +548,12 @@ fn move_unpaired_to_mean_size(
                 let Some(n) = t.neighbour(h) else { continue };
                 let Some(sine) = good(h) else { continue };
                 let p = partner[n.index()];
-                if mark[n.index()] == round
-                    || p == NONE
-                    || mark[p as usize] == round
-                    || keeps(n, p)
-                    || sine < pair_sine(n, p) - EVEN_SIZE_PAIR_SLACK
-                {
+                if mark[n.index()] == round || p == NONE || mark[p as usize] == round {
+                    continue;
+                }
+                // The pair the path would undo: not one the matching keeps, nor much better.
+                let undone = pair_sine(n, p);
+                if undone >= KEEP_PAIR || sine < undone - EVEN_SIZE_PAIR_SLACK {
                     continue;
                 }
                 mark[n.index()] = round;
