@@ -58,8 +58,8 @@ pub use dt::{
 };
 pub use mesh::{Holder, QuadMesh, SURE_JACOBIAN};
 pub use pairing::{
-    Element, ElementMesh, Pairing, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER, MIN_PINNED_CORNER_SHAPE,
-    PINNED_OBTUSE_DEG,
+    Element, ElementMesh, Pairing, LARGE_PAIR, MIN_FEWEST_CORNER, MIN_MATCHING_CORNER,
+    MIN_PINNED_CORNER_SHAPE, PINNED_OBTUSE_DEG, SPLIT_MARGIN,
 };
 pub use patch::{basis, ControlNet, TRIANGLE_SLOTS};
 pub use template::{Place, Template};

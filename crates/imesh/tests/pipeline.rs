@@ -336,11 +336,12 @@ fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
     assert!(mean(&auto) > mean(&coarse) + 0.02);
 }
 
-/// Where the band along the boundaries pulls the mean quad area off the lattice's (pyvista's
-/// channels: the median quad, a lattice one, is 0.971 of the mean; 0.987 since thin strips'
-/// boundary pieces are cut to the strips' depth), the lattice is scaled to match and kept for
-/// its higher shape-and-size (0.859 → 0.872); where the lattice fits (MRI, to 0.1 %), it
-/// stays.
+/// Where the band along the boundaries pulls the mean quad area off the lattice's (the camera:
+/// the median quad, a lattice one, is 1.015 times the mean), the lattice is scaled to match and
+/// kept for its higher shape-and-size; where the lattice fits (MRI, to 0.1 %), it stays.
+/// (Pyvista's channels were the scaled example, 0.971 and then 0.987 of the mean, until the
+/// matching left its large band pairs as triangles: their quads, two thirds as large, bring the
+/// mean to the lattice's.)
 #[test]
 fn the_lattice_is_scaled_to_the_mean_quad() {
     let run = |name: &str| {
@@ -350,18 +351,18 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
             .report
     };
     let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
-    let channels = run("pyvista-channels_z050_labels.png");
+    let camera = run("skimage-camera.png");
     let mri = run("matplotlib-s1045_mri.png");
     eprintln!(
-        "pyvista: lattice × {:.4}, mean S&S {:.4}; MRI: × {:.4}, {:.4}",
-        channels.counts.lattice_scale,
-        mean(&channels),
+        "camera: lattice × {:.4}, mean S&S {:.4}; MRI: × {:.4}, {:.4}",
+        camera.counts.lattice_scale,
+        mean(&camera),
         mri.counts.lattice_scale,
         mean(&mri)
     );
-    assert!(channels.validation.valid && mri.validation.valid);
-    assert!((1.01..=1.04).contains(&channels.counts.lattice_scale));
-    assert!(mean(&channels) >= 0.865, "{}", mean(&channels));
+    assert!(camera.validation.valid && mri.validation.valid);
+    assert!((0.97..=0.995).contains(&camera.counts.lattice_scale));
+    assert!(mean(&camera) >= 0.9, "{}", mean(&camera));
     assert_eq!(mri.counts.lattice_scale, 1.0);
     // 0.9086 since thin strips' pieces are cut (0.9113 before): a strip-shaped island's
     // shorter pieces make the band outside it finer; 0.9048 since unpaired triangles sharp
@@ -372,8 +373,8 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     assert!(mean(&mri) >= 0.903);
 }
 
-/// The lattice's second try is only a try: on grass it is finer (0.969) and makes 69 634
-/// quads; under a limit of 69 000 the run keeps the first mesh (67 653) instead of failing.
+/// The lattice's second try is only a try: on grass it is finer (0.934) and makes 76 029
+/// quads; under a limit of 73 000 the run keeps the first mesh (70 757) instead of failing.
 #[test]
 fn a_second_lattice_over_a_limit_keeps_the_first() {
     let run = |max_elements: u64| {
@@ -386,7 +387,7 @@ fn a_second_lattice_over_a_limit_keeps_the_first() {
         .report
     };
     let free = run(MeshOptions::default().max_elements);
-    let limited = run(69_000);
+    let limited = run(73_000);
     eprintln!(
         "grass: × {:.4}, {} quads; limited: × {:.4}, {} quads",
         free.counts.lattice_scale,
@@ -394,9 +395,9 @@ fn a_second_lattice_over_a_limit_keeps_the_first() {
         limited.counts.lattice_scale,
         limited.counts.quads
     );
-    assert!(free.counts.lattice_scale < 1.0 && free.counts.quads > 69_000);
+    assert!(free.counts.lattice_scale < 1.0 && free.counts.quads > 73_000);
     assert_eq!(limited.counts.lattice_scale, 1.0);
-    assert!(limited.counts.quads <= 69_000);
+    assert!(limited.counts.quads <= 73_000);
     assert!(limited.validation.valid);
 }
 
