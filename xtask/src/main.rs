@@ -5,6 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
+//! cargo xtask bench random [--count N] [--seed S]
 //! cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -14,6 +15,7 @@ mod alloc;
 mod bench_delaunay;
 mod bench_optim;
 mod bench_pipeline;
+mod bench_random;
 mod bench_refine;
 mod compare_gmsh;
 mod fixtures;
@@ -25,6 +27,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
+       cargo xtask bench random [--count N] [--seed S]
        cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -50,6 +53,14 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    writes target/bench/pipeline.md and pipeline.json
     --scaling-max SIDE   largest side of the scaling series (default 4096)
     --readme             also write the tables into README.md's results section
+
+  bench random     the defaults on random label images (Voronoi cells, smoothed noise cut at
+                   quantiles, discs and rectangles; 120-300 px): mean of the mean and of the
+                   worst shape-and-size, quads under 0.25, under 0.5 in shape and in scaled
+                   Jacobian, per image and summed (what a change is judged by: one image's
+                   worst quads move by chance); writes target/bench/random.json
+    --count N      images (default 150)
+    --seed S       the images' seed (default 52)
 
   compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
                    same simplified boundaries of the fixtures (five label-like ones unless
@@ -129,6 +140,25 @@ fn run(args: &[String]) -> Result<(), String> {
                 }
             }
             bench_pipeline::run(side, readme)
+        }
+        ["bench", "random", rest @ ..] => {
+            let (mut count, mut seed, mut rest) = (150, 52, rest);
+            loop {
+                match rest {
+                    [] => break,
+                    [flag @ "--count", n, more @ ..] => {
+                        (count, rest) = (positive(flag, Some(n))?, more);
+                    }
+                    ["--seed", n, more @ ..] => {
+                        seed = n
+                            .parse()
+                            .map_err(|_| format!("--seed takes an integer, not '{n}'"))?;
+                        rest = more;
+                    }
+                    _ => return Err(format!("unknown options '{}'", rest.join(" "))),
+                }
+            }
+            bench_random::run(count, seed)
         }
         ["compare", "gmsh", rest @ ..] => {
             let mut options = imesh::MeshOptions::default();
