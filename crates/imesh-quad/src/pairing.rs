@@ -2,6 +2,7 @@
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::{HalfEdgeId, Point, TriangleId, Triangulation, VertexId};
+use imesh_quality::quad::{self, Quad};
 
 use crate::dt::NONE;
 use crate::mesh::{scaled_jacobian, valid_above};
@@ -87,11 +88,13 @@ impl ElementMesh {
                     || matching(t, MIN_MATCHING_CORNER, true, true, false),
                     || matching(t, MIN_MATCHING_CORNER, true, true, true),
                 );
-                let kept = Self::from_partners(t, &kept);
-                if split == kept_partners(t, &kept) {
-                    return kept;
+                if split == kept {
+                    return Self::from_partners(t, &kept);
                 }
-                let split = Self::from_partners(t, &split);
+                let (kept, split) = (
+                    Self::from_partners(t, &kept),
+                    Self::from_partners(t, &split),
+                );
                 return if split.straight_shape_and_size(t)
                     > kept.straight_shape_and_size(t) - SPLIT_MARGIN
                 {
@@ -119,7 +122,7 @@ impl ElementMesh {
     /// assert!((m.straight_shape_and_size(&t) - 1.0).abs() < 1e-12); // four unit squares
     /// ```
     pub fn straight_shape_and_size(&self, t: &Triangulation) -> f64 {
-        let quads: Vec<(f64, f64)> = self
+        let quads: Vec<Quad> = self
             .elements
             .par_iter()
             .flat_map_iter(|e| {
@@ -132,7 +135,7 @@ impl ElementMesh {
                 let centre = c.iter().fold(Point::new(0.0, 0.0), |a, &p| a + p) * (1.0 / n as f64);
                 (0..n).map(move |i| {
                     let (prev, next) = (c[(i + n - 1) % n], c[(i + 1) % n]);
-                    shape_and_area(&[c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])])
+                    [c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])].map(|p| [p.x, p.y])
                 })
             })
             .collect();
@@ -140,13 +143,10 @@ impl ElementMesh {
             return 0.0;
         }
         // In order, so that the sums do not depend on the threads.
-        let mean = quads.iter().map(|q| q.1).sum::<f64>() / quads.len() as f64;
+        let mean = quads.iter().map(quad::area).sum::<f64>() / quads.len() as f64;
         quads
             .iter()
-            .map(|&(shape, area)| {
-                let r = (area / mean).min(mean / area);
-                shape * r * r
-            })
+            .map(|q| quad::shape_and_size(q, mean))
             .sum::<f64>()
             / quads.len() as f64
     }
@@ -565,34 +565,6 @@ fn too_large(t: &Triangulation, h: HalfEdgeId, mean_quad: f64) -> bool {
     (triangle_area(t, f) + triangle_area(t, n)) / 4.0 > LARGE_PAIR * mean_quad
         && smallest_corner_sine(t, f) >= LARGE_PAIR_BLUNT
         && smallest_corner_sine(t, n) >= LARGE_PAIR_BLUNT
-}
-
-/// The partner of each triangle slot in `m` ([`NONE`] for an unpaired triangle or a ghost).
-fn kept_partners(t: &Triangulation, m: &ElementMesh) -> Vec<u32> {
-    let mut partner = vec![NONE; t.num_triangle_slots()];
-    let mut first = vec![NONE; m.elements.len()];
-    for f in t.triangles() {
-        let e = m.element_of_triangle[f.index()] as usize;
-        if matches!(m.elements.get(e), Some(Element::Quad(_))) {
-            match first[e] {
-                NONE => first[e] = f.index() as u32,
-                g => pair_up(&mut partner, f, TriangleId::new(g)),
-            }
-        }
-    }
-    partner
-}
-
-/// Verdict's shape of the counter-clockwise quad `p`, and its area.
-fn shape_and_area(p: &[Point; 4]) -> (f64, f64) {
-    let (mut shape, mut area) = (f64::INFINITY, 0.0);
-    for k in 0..4 {
-        let (u, v) = (p[(k + 1) % 4] - p[k], p[(k + 3) % 4] - p[k]);
-        let alpha = u.x * v.y - u.y * v.x;
-        shape = shape.min(2.0 * alpha / (u.x * u.x + u.y * u.y + v.x * v.x + v.y * v.y));
-        area += p[k].x * p[(k + 1) % 4].y - p[(k + 1) % 4].x * p[k].y;
-    }
-    (shape.max(0.0), 0.5 * area)
 }
 
 /// Re-pairs an alternating path of a search from `start` back from its free end `n`: each
