@@ -10,6 +10,7 @@
 //! compare: the worst quads of one image move when anything changes (renumbering one mesh's
 //! triangles moved the count under 0.5 in shape by about 7 over 150 images).
 
+use std::path::Path;
 use std::time::Instant;
 
 use image::{DynamicImage, GrayImage, Luma};
@@ -48,9 +49,18 @@ struct Summary {
     seconds: f64,
 }
 
-/// Meshes `count` random images drawn from `seed` with the default options and writes the
-/// figures.
-pub fn run(count: usize, seed: u64) -> Result<(), String> {
+/// Meshes `count` random images drawn from `seed` with `options` (the defaults, or another
+/// optimiser) and writes the figures; with `images`, also each image as a PNG in that folder.
+pub fn run(
+    count: usize,
+    seed: u64,
+    options: &MeshOptions,
+    images: Option<&Path>,
+) -> Result<(), String> {
+    if let Some(dir) = images {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut rows = Vec::with_capacity(count);
     for i in 0..count {
@@ -60,7 +70,13 @@ pub fn run(count: usize, seed: u64) -> Result<(), String> {
             _ => ("shapes", shapes(&mut rng)),
         };
         let name = format!("{i:03}-{kind}");
-        let row = measure(&name, image)?;
+        if let Some(dir) = images {
+            let path = dir.join(format!("{name}.png"));
+            image
+                .save(&path)
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        }
+        let row = measure(&name, image, options)?;
         eprintln!(
             "{name}: {} quads, mean {:.4}, worst {:.4}",
             row.quads, row.mean, row.worst
@@ -102,11 +118,11 @@ pub fn run(count: usize, seed: u64) -> Result<(), String> {
     Ok(())
 }
 
-/// The default pipeline on `image`, its quads measured as the report measures them.
-fn measure(name: &str, image: GrayImage) -> Result<Row, String> {
+/// The pipeline with `options` on `image`, its quads measured as the report measures them.
+fn measure(name: &str, image: GrayImage, options: &MeshOptions) -> Result<Row, String> {
     let (width, height) = image.dimensions();
     let clock = Instant::now();
-    let result = Pipeline::new(MeshOptions::default())
+    let result = Pipeline::new(options.clone())
         .run_image(&DynamicImage::ImageLuma8(image))
         .map_err(|e| format!("{name}: {e}"))?;
     let seconds = clock.elapsed().as_secs_f64();

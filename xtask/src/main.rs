@@ -5,7 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-//! cargo xtask bench random [--count N] [--seed S]
+//! cargo xtask bench random [--count N] [--seed S] [--optimizer M] [--images DIR]
 //! cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -27,7 +27,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-       cargo xtask bench random [--count N] [--seed S]
+       cargo xtask bench random [--count N] [--seed S] [--optimizer M] [--images DIR]
        cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -61,6 +61,8 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    worst quads move by chance); writes target/bench/random.json
     --count N      images (default 150)
     --seed S       the images' seed (default 52)
+    --optimizer M  the optimiser to run instead of the default (local, vertex, laplacian, none)
+    --images DIR   also write each image there as NNN-KIND.png (to mesh one alone)
 
   compare gmsh     our quad mesh against Gmsh's (Blossom full-quad and quasi-structured) on the
                    same simplified boundaries of the fixtures (five label-like ones unless
@@ -143,6 +145,8 @@ fn run(args: &[String]) -> Result<(), String> {
         }
         ["bench", "random", rest @ ..] => {
             let (mut count, mut seed, mut rest) = (150, 52, rest);
+            let mut images = None;
+            let mut options = imesh::MeshOptions::default();
             loop {
                 match rest {
                     [] => break,
@@ -155,10 +159,16 @@ fn run(args: &[String]) -> Result<(), String> {
                             .map_err(|_| format!("--seed takes an integer, not '{n}'"))?;
                         rest = more;
                     }
+                    ["--optimizer", method, more @ ..] => {
+                        (options.optimizer, rest) = (method.parse()?, more);
+                    }
+                    ["--images", dir, more @ ..] => {
+                        (images, rest) = (Some(std::path::PathBuf::from(dir)), more);
+                    }
                     _ => return Err(format!("unknown options '{}'", rest.join(" "))),
                 }
             }
-            bench_random::run(count, seed)
+            bench_random::run(count, seed, &options, images.as_deref())
         }
         ["compare", "gmsh", rest @ ..] => {
             let mut options = imesh::MeshOptions::default();
