@@ -166,6 +166,24 @@ pub struct OptimOptions {
     pub tolerance: f64,
     /// Most sweeps (local, vertex and Laplacian modes).
     pub max_sweeps: usize,
+    /// The local mode's sweeps over the control points, after which the quad vertices
+    /// themselves move (as in the vertex mode) until a sweep lowers the energy by less than
+    /// [`OptimOptions::vertex_tolerance`]; `None`: the control points alone, until
+    /// [`OptimOptions::tolerance`]. A control point moves the quads of its patches together,
+    /// which the first sweeps need (sizes evened out over whole elements); what is left after
+    /// them is each vertex among its own quads, which a vertex moves at half the cost of a
+    /// control point (it moves one mesh point, not the template points of two patches).
+    /// Measured with the defaults (`cargo xtask bench random`, 150 images; optimiser seconds
+    /// on one thread summed over coins, stardist, gravel, grass and brick, each the least of
+    /// three runs): the control points alone, 0.8921 and 4.5–4.8 s; two sweeps then the
+    /// vertices to 1.5 %, 0.8935 and 4.6 s (every fixture's mean up, by 0.0003 on camera to
+    /// 0.0035 on grass); one sweep then 3 %, 0.8922 and 3.8 s; the control points alone then
+    /// the vertices to 3 %, 0.8937 and 5.3 s; the control points alone to 1 %, 0.8932; the
+    /// vertex mode alone to 3 %, 1 % and 0.5 %: 0.8913 and 3.2 s, 0.8936 and 4.6 s, 0.8942.
+    pub control_sweeps: Option<usize>,
+    /// The energy drop under which the local mode's vertex sweeps stop
+    /// ([`OptimOptions::control_sweeps`]).
+    pub vertex_tolerance: f64,
     /// The minimiser of each local solve.
     pub local_solver: LocalSolver,
     /// Most Powell iterations of each local solve (twice as many L-BFGS ones).
@@ -238,6 +256,8 @@ impl Default for OptimOptions {
             metric: Metric::ShapeAndSize,
             tolerance: 3e-2,
             max_sweeps: 40,
+            control_sweeps: Some(2),
+            vertex_tolerance: 1.5e-2,
             local_solver: LocalSolver::Powell,
             local_iterations: 1,
             global_iterations: 20,
@@ -283,8 +303,8 @@ pub struct OptimReport {
     pub energy_before: f64,
     /// Energy after.
     pub energy_after: f64,
-    /// Sweeps (local modes, the sliding and its vertex pass included) or Powell iterations
-    /// (global).
+    /// Sweeps (local modes: the control points' and the vertices' after them, the sliding and
+    /// its vertex pass included) or Powell iterations (global).
     pub sweeps: usize,
     /// Quad vertices that slid along the boundary curves ([`OptimOptions::slide`]).
     pub sliders: usize,
@@ -544,6 +564,9 @@ fn measure(vertices: &[Point], quads: &[[u32; 4]]) -> (QuadQuality, QuadHistogra
 struct Prepared {
     /// The method's variables (none for [`Method::None`]).
     variables: Option<Variables>,
+    /// The free quad vertices the local mode moves after its control points
+    /// ([`OptimOptions::control_sweeps`]).
+    vertex_variables: Option<Variables>,
     /// The sliders, and the free vertices near them that follow them (when sliding).
     sliders: slide::Sliders,
     polish_variables: Option<Variables>,
@@ -555,31 +578,40 @@ struct Prepared {
 /// [`Prepared`] for `method`: the variables on one side, the sliders, the sliding's vertex
 /// variables and the start's quality on the other (all read the mesh only; most of the
 /// variables' indexing is sequential).
-fn prepare(remesh: &Remesh, method: Method, sliding: bool) -> Prepared {
+fn prepare(remesh: &Remesh, options: &OptimOptions, sliding: bool) -> Prepared {
     let t = &remesh.dt.triangulation;
     let (elements, mesh) = (&remesh.elements, &remesh.mesh);
-    let (variables, (sliders, polish_variables, (before, histograms_before))) = rayon::join(
-        || match method {
-            Method::None => None,
-            Method::Laplacian | Method::Vertex => Some(Variables::vertices(t, elements, mesh)),
-            Method::Local | Method::Global => {
-                Some(Variables::control_points(t, elements, &remesh.net, mesh))
-            }
-        },
-        || {
-            let (sliders, polish) = if sliding {
-                let sliders = slide::Sliders::new(remesh);
-                let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
-                let polish = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
-                (sliders, Some(polish))
-            } else {
-                (slide::Sliders::default(), None)
-            };
-            (sliders, polish, measure(&mesh.vertices, &mesh.quads))
-        },
-    );
+    let then_vertices = options.method == Method::Local && options.control_sweeps.is_some();
+    let ((variables, vertex_variables), (sliders, polish_variables, (before, histograms_before))) =
+        rayon::join(
+            || match options.method {
+                Method::None => (None, None),
+                Method::Laplacian | Method::Vertex => {
+                    (Some(Variables::vertices(t, elements, mesh)), None)
+                }
+                Method::Local | Method::Global => {
+                    let (control, vertices) = rayon::join(
+                        || Variables::control_points(t, elements, &remesh.net, mesh),
+                        || then_vertices.then(|| Variables::vertices(t, elements, mesh)),
+                    );
+                    (Some(control), vertices)
+                }
+            },
+            || {
+                let (sliders, polish) = if sliding {
+                    let sliders = slide::Sliders::new(remesh);
+                    let near = sliders.near(&mesh.quads, mesh.vertices.len(), POLISH_RINGS);
+                    let polish = Variables::vertices_where(t, elements, mesh, |v| near[v as usize]);
+                    (sliders, Some(polish))
+                } else {
+                    (slide::Sliders::default(), None)
+                };
+                (sliders, polish, measure(&mesh.vertices, &mesh.quads))
+            },
+        );
     Prepared {
         variables,
+        vertex_variables,
         sliders,
         polish_variables,
         before,
@@ -604,11 +636,12 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     }
     let Prepared {
         variables: prepared,
+        vertex_variables,
         mut sliders,
         polish_variables,
         before,
         histograms_before,
-    } = prepare(remesh, options.method, sliding);
+    } = prepare(remesh, options, sliding);
     let Remesh {
         dt,
         elements,
@@ -683,13 +716,28 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             (vars.len(), vars.colours.len(), sweeps)
         }
         (Method::Local, Some(vars)) => {
-            let sweeps = local::descend(
+            let control = Setup {
+                max_sweeps: options.control_sweeps.unwrap_or(setup.max_sweeps),
+                ..setup
+            };
+            let mut sweeps = local::descend(
                 vars,
                 &mut mesh.vertices,
                 Some(&mut net.points),
-                setup,
+                control,
                 |v| setup.energy(v),
             );
+            // Then the quad vertices, from where the control points left them (the net is no
+            // longer read: the mesh is the result).
+            if let Some(vertex_vars) = &vertex_variables {
+                let vertices = Setup {
+                    tolerance: options.vertex_tolerance,
+                    ..setup
+                };
+                sweeps += local::descend(vertex_vars, &mut mesh.vertices, None, vertices, |v| {
+                    setup.energy(v)
+                });
+            }
             (vars.len(), vars.colours.len(), sweeps)
         }
         (Method::Global, Some(vars)) => {
