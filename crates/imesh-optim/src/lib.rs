@@ -4,7 +4,8 @@
 //! minimise `q_s = Σ (1 − s(ν))²` over the quads ν, `s` being Verdict's shape-and-size against
 //! the mesh's fixed average quad area ([`Metric::ShapeAndSize`]) or shape ([`Metric::Shape`]),
 //! by moving the free Bézier control points: those not on a c-edge or on the domain border, so
-//! that every region keeps its fitted boundary. Quad vertices follow their patches.
+//! that every region keeps its fitted boundary. Quad vertices follow their patches, until the
+//! local mode hands over to the free quad vertices themselves.
 //!
 //! A move is feasible only if every quad keeps positive Jacobians at its four corners (exact
 //! orientation), every moved control point stays strictly inside the polygon of its
@@ -16,7 +17,7 @@
 //!
 //! [`Method`]s: [`Method::Local`] (default) is block coordinate descent, one control point at a
 //! time by [`Powell`]'s method, points coloured so that one colour shares no quad and is solved
-//! in parallel; [`Method::Global`] is the paper's single Powell run over all variables;
+//! in parallel, the free quad vertices after two sweeps ([`OptimOptions::control_sweeps`]); [`Method::Global`] is the paper's single Powell run over all variables;
 //! [`Method::Laplacian`] and [`Method::Vertex`] are baselines that move the quad vertices
 //! directly. The repairs after the descent ([`OptimOptions::repair`]) are runs of small
 //! searches, each seeing the moves before it; they run side by side wherever neither of two
