@@ -5,7 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-//! cargo xtask bench random [--count N] [--seed S] [--optimizer M] [--images DIR]
+//! cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--images DIR]
 //! cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -27,7 +27,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-       cargo xtask bench random [--count N] [--seed S] [--optimizer M] [--images DIR]
+       cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--images DIR]
        cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -61,6 +61,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
                    worst quads move by chance); writes target/bench/random.json
     --count N      images (default 150)
     --seed S       the images' seed (default 52)
+    --size S       the quad size instead of the default (auto, graded or pixels)
     --optimizer M  the optimiser to run instead of the default (local, vertex, laplacian, none)
     --images DIR   also write each image there as NNN-KIND.png (to mesh one alone)
 
@@ -159,6 +160,7 @@ fn run(args: &[String]) -> Result<(), String> {
                             .map_err(|_| format!("--seed takes an integer, not '{n}'"))?;
                         rest = more;
                     }
+                    ["--size", size, more @ ..] => (options.size, rest) = (size.parse()?, more),
                     ["--optimizer", method, more @ ..] => {
                         (options.optimizer, rest) = (method.parse()?, more);
                     }
