@@ -84,20 +84,24 @@ impl ElementMesh {
         let partner = match method {
             Pairing::Greedy => greedy(t),
             Pairing::Matching => {
+                // Both candidates weigh the same quads: their corner sines are found once.
+                let sines = corner_sines(t, MIN_MATCHING_CORNER, true);
                 let (kept, split) = rayon::join(
-                    || matching(t, MIN_MATCHING_CORNER, true, true, false),
-                    || matching(t, MIN_MATCHING_CORNER, true, true, true),
+                    || matching_on(t, &sines, true, false),
+                    || matching_on(t, &sines, true, true),
                 );
                 if split == kept {
                     return Self::from_partners(t, &kept);
                 }
-                let (kept, split) = (
-                    Self::from_partners(t, &kept),
-                    Self::from_partners(t, &split),
+                let (kept, split) = rayon::join(
+                    || Self::from_partners(t, &kept),
+                    || Self::from_partners(t, &split),
                 );
-                return if split.straight_shape_and_size(t)
-                    > kept.straight_shape_and_size(t) - SPLIT_MARGIN
-                {
+                let (kept_score, split_score) = rayon::join(
+                    || kept.straight_shape_and_size(t),
+                    || split.straight_shape_and_size(t),
+                );
+                return if split_score > kept_score - SPLIT_MARGIN {
                     split
                 } else {
                     kept
@@ -122,33 +126,30 @@ impl ElementMesh {
     /// assert!((m.straight_shape_and_size(&t) - 1.0).abs() < 1e-12); // four unit squares
     /// ```
     pub fn straight_shape_and_size(&self, t: &Triangulation) -> f64 {
-        let quads: Vec<Quad> = self
-            .elements
-            .par_iter()
-            .flat_map_iter(|e| {
-                let c: Vec<Point> = e
-                    .corners()
-                    .iter()
-                    .map(|&v| t.point(VertexId::new(v)))
-                    .collect();
-                let n = c.len();
-                let centre = c.iter().fold(Point::new(0.0, 0.0), |a, &p| a + p) * (1.0 / n as f64);
-                (0..n).map(move |i| {
-                    let (prev, next) = (c[(i + n - 1) % n], c[(i + 1) % n]);
-                    [c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])].map(|p| [p.x, p.y])
+        // Summed over chunks of elements of a fixed length, then the chunks' sums in order: the
+        // same sums on any number of threads.
+        let sum = |term: &(dyn Fn(&Quad) -> f64 + Sync)| {
+            self.elements
+                .par_chunks(SUM_CHUNK)
+                .map(|chunk| {
+                    chunk
+                        .iter()
+                        .map(|e| {
+                            let (quads, n) = straight_quads(t, e);
+                            quads[..n].iter().map(term).sum::<f64>()
+                        })
+                        .sum::<f64>()
                 })
-            })
-            .collect();
-        if quads.is_empty() {
+                .collect::<Vec<f64>>()
+                .iter()
+                .sum::<f64>()
+        };
+        let count = 3 * self.unpaired + 4 * (self.elements.len() - self.unpaired);
+        if count == 0 {
             return 0.0;
         }
-        // In order, so that the sums do not depend on the threads.
-        let mean = quads.iter().map(quad::area).sum::<f64>() / quads.len() as f64;
-        quads
-            .iter()
-            .map(|q| quad::shape_and_size(q, mean))
-            .sum::<f64>()
-            / quads.len() as f64
+        let mean = sum(&quad::area) / count as f64;
+        sum(&|q| quad::shape_and_size(q, mean)) / count as f64
     }
 
     /// The M edge on `side` of element `element`, and whether the element walks it in the
@@ -242,6 +243,28 @@ impl ElementMesh {
             element_of_triangle,
         }
     }
+}
+
+/// The length of the chunks of elements [`ElementMesh::straight_shape_and_size`] sums in
+/// parallel.
+const SUM_CHUNK: usize = 1024;
+
+/// The straight level-1 template quads of element `e` (each corner, its sides' midpoints and
+/// the centre), in the first 3 or 4 places.
+fn straight_quads(t: &Triangulation, e: &Element) -> ([Quad; 4], usize) {
+    let corners = e.corners();
+    let n = corners.len();
+    let mut c = [Point::new(0.0, 0.0); 4];
+    for (p, &v) in c.iter_mut().zip(corners) {
+        *p = t.point(VertexId::new(v));
+    }
+    let centre = c[..n].iter().fold(Point::new(0.0, 0.0), |a, &p| a + p) * (1.0 / n as f64);
+    let mut quads = [[[0.0; 2]; 4]; 4];
+    for (i, q) in quads.iter_mut().enumerate().take(n) {
+        let (prev, next) = (c[(i + n - 1) % n], c[(i + 1) % n]);
+        *q = [c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])].map(|p| [p.x, p.y]);
+    }
+    (quads, n)
 }
 
 /// [`Triangulation::edges`] in parallel, in the same order when collected.
@@ -427,7 +450,8 @@ const MAX_AUGMENTING_DEPTH: usize = 8;
 /// Best quads first, then augmenting paths for the triangles left; no quad with a corner sine
 /// under `min_corner`, nor, with `pinned`, an unfair pinned corner ([`pinned_corners_fair`]);
 /// with `even_sizes`, the triangles left then moved to where their quads come nearer the mean
-/// quad's area ([`move_unpaired_to_mean_size`]).
+/// quad's area ([`move_unpaired_to_mean_size`]); with `split_large`, no large blunt pair
+/// ([`too_large`]).
 fn matching(
     t: &Triangulation,
     min_corner: f64,
@@ -435,6 +459,34 @@ fn matching(
     even_sizes: bool,
     split_large: bool,
 ) -> Vec<u32> {
+    matching_on(
+        t,
+        &corner_sines(t, min_corner, pinned),
+        even_sizes,
+        split_large,
+    )
+}
+
+/// Per half-edge of `t`: the worst corner sine of the quad across it ([`corner_sine`]), NaN
+/// where it forms none. The searches ask for the same edges again and again (the best-first
+/// order, an augmenting search from every free triangle, the pairs it would undo, the moves of
+/// the triangles left), and [`Pairing::Matching`]'s two candidates for the same quads. Both
+/// half-edges of an edge hold the same value, as [`corner_sine`] finds it from either: the
+/// same quad, its corners in the same cyclic order.
+fn corner_sines(t: &Triangulation, min_corner: f64, pinned: bool) -> Vec<f64> {
+    let found: Vec<(HalfEdgeId, f64)> = par_edges(t)
+        .filter_map(|h| Some((h, corner_sine(t, h, min_corner, pinned)?)))
+        .collect();
+    let mut sines = vec![f64::NAN; 3 * t.num_triangle_slots()];
+    for (h, w) in found {
+        sines[h.index()] = w;
+        sines[t.twin(h).index()] = w;
+    }
+    sines
+}
+
+/// [`matching`] with the corner sines found ([`corner_sines`]).
+fn matching_on(t: &Triangulation, sines: &[f64], even_sizes: bool, split_large: bool) -> Vec<u32> {
     let mean_quad = if split_large {
         let (area, count) = t
             .triangles()
@@ -444,8 +496,9 @@ fn matching(
         f64::INFINITY
     };
     let good = |h: HalfEdgeId| {
-        let w = corner_sine(t, h, min_corner, pinned)?;
-        (w >= KEEP_PAIR || !too_large(t, h, mean_quad)).then_some(w)
+        let w = sines[h.index()];
+        (!w.is_nan() && (w >= KEEP_PAIR || !(split_large && too_large(t, h, mean_quad))))
+            .then_some(w)
     };
     // Whether the pair of `n` and its partner `p` is one an augmenting path keeps.
     let keeps = |n: TriangleId, p: u32| {
@@ -838,6 +891,40 @@ mod tests {
             let floor = kept.straight_shape_and_size(&t) - SPLIT_MARGIN;
             prop_assert!(chosen.straight_shape_and_size(&t) >= floor);
             prop_assert!(chosen.unpaired == kept.unpaired || chosen.unpaired == s.len());
+        }
+
+        /// On random points, the straight templates' shape-and-size summed in parallel chunks
+        /// is the mean over the template quads built one by one, and the corner sines found
+        /// once are those of either half-edge.
+        #[test]
+        fn straight_quality_and_corner_sines_are_the_direct_ones(
+            points in proptest::collection::vec((0u32..40, 0u32..40), 8..60),
+            stretch in 0.2f64..1.0,
+        ) {
+            let Some(t) = triangulated(points, stretch) else {
+                return Ok(());
+            };
+            let m = ElementMesh::pair(&t, Pairing::Matching);
+            let mut quads = Vec::new();
+            for e in &m.elements {
+                let c: Vec<Point> = e.corners().iter().map(|&v| t.point(VertexId::new(v))).collect();
+                let n = c.len() as f64;
+                let centre = c.iter().fold(Point::new(0.0, 0.0), |a, &p| a + p) * (1.0 / n);
+                for i in 0..c.len() {
+                    let (prev, next) = (c[(i + c.len() - 1) % c.len()], c[(i + 1) % c.len()]);
+                    quads.push([c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])].map(|p| [p.x, p.y]));
+                }
+            }
+            let mean = quads.iter().map(quad::area).sum::<f64>() / quads.len() as f64;
+            let direct = quads.iter().map(|q| quad::shape_and_size(q, mean)).sum::<f64>() / quads.len() as f64;
+            prop_assert!((m.straight_shape_and_size(&t) - direct).abs() < 1e-12);
+            let sines = corner_sines(&t, MIN_MATCHING_CORNER, true);
+            for f in t.triangles() {
+                for h in t.triangle_edges(f) {
+                    let direct = corner_sine(&t, h, MIN_MATCHING_CORNER, true);
+                    prop_assert_eq!(direct.map(f64::to_bits), (!sines[h.index()].is_nan()).then(|| sines[h.index()].to_bits()));
+                }
+            }
         }
 
         /// On random points, moving the unpaired triangles leaves as many, each pair one the
