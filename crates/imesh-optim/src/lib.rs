@@ -17,7 +17,8 @@
 //!
 //! [`Method`]s: [`Method::Local`] (default) is block coordinate descent, one control point at a
 //! time by [`Powell`]'s method, points coloured so that one colour shares no quad and is solved
-//! in parallel, the free quad vertices after two sweeps ([`OptimOptions::control_sweeps`]); [`Method::Global`] is the paper's single Powell run over all variables;
+//! in parallel, the free quad vertices after two sweeps ([`OptimOptions::control_sweeps`]);
+//! [`Method::Global`] is the paper's single Powell run over all variables;
 //! [`Method::Laplacian`] and [`Method::Vertex`] are baselines that move the quad vertices
 //! directly. The repairs after the descent ([`OptimOptions::repair`]) are runs of small
 //! searches, each seeing the moves before it; they run side by side wherever neither of two
@@ -180,7 +181,7 @@ pub struct OptimOptions {
     /// vertices to 1.5 %, 0.8935 and 4.6 s (every fixture's mean up, by 0.0003 on camera to
     /// 0.0035 on grass); one sweep then 3 %, 0.8922 and 3.8 s; the control points alone then
     /// the vertices to 3 %, 0.8937 and 5.3 s; the control points alone to 1 %, 0.8932; the
-    /// vertex mode alone to 3 %, 1 % and 0.5 %: 0.8913 and 3.2 s, 0.8936 and 4.6 s, 0.8942.
+    /// vertex mode alone to 3 %, 1 % and 0.5 %: 0.8920 and 3.2 s, 0.8936 and 4.6 s, 0.8942.
     pub control_sweeps: Option<usize>,
     /// The energy drop under which the local mode's vertex sweeps stop
     /// ([`OptimOptions::control_sweeps`]).

@@ -907,22 +907,27 @@ mod tests {
             let m = ElementMesh::pair(&t, Pairing::Matching);
             let mut quads = Vec::new();
             for e in &m.elements {
-                let c: Vec<Point> = e.corners().iter().map(|&v| t.point(VertexId::new(v))).collect();
+                let c: Vec<Point> =
+                    e.corners().iter().map(|&v| t.point(VertexId::new(v))).collect();
                 let n = c.len() as f64;
                 let centre = c.iter().fold(Point::new(0.0, 0.0), |a, &p| a + p) * (1.0 / n);
                 for i in 0..c.len() {
                     let (prev, next) = (c[(i + c.len() - 1) % c.len()], c[(i + 1) % c.len()]);
-                    quads.push([c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])].map(|p| [p.x, p.y]));
+                    let q = [c[i], c[i].midpoint(next), centre, prev.midpoint(c[i])];
+                    quads.push(q.map(|p| [p.x, p.y]));
                 }
             }
             let mean = quads.iter().map(quad::area).sum::<f64>() / quads.len() as f64;
-            let direct = quads.iter().map(|q| quad::shape_and_size(q, mean)).sum::<f64>() / quads.len() as f64;
+            let direct = quads.iter().map(|q| quad::shape_and_size(q, mean)).sum::<f64>()
+                / quads.len() as f64;
             prop_assert!((m.straight_shape_and_size(&t) - direct).abs() < 1e-12);
             let sines = corner_sines(&t, MIN_MATCHING_CORNER, true);
             for f in t.triangles() {
                 for h in t.triangle_edges(f) {
                     let direct = corner_sine(&t, h, MIN_MATCHING_CORNER, true);
-                    prop_assert_eq!(direct.map(f64::to_bits), (!sines[h.index()].is_nan()).then(|| sines[h.index()].to_bits()));
+                    let cached = sines[h.index()];
+                    let cached = (!cached.is_nan()).then(|| cached.to_bits());
+                    prop_assert_eq!(direct.map(f64::to_bits), cached);
                 }
             }
         }

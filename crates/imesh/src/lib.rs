@@ -194,11 +194,12 @@ pub const BORDER_SLIVER: f64 = 0.25;
 /// (`cargo xtask bench random --size 3`): mean of the means 0.85748 → 0.85881, quads under
 /// 0.25 10 801 → 9 603, under 0.5 in shape 92 → 55 and in scaled Jacobian 10 → 9 (there the
 /// fixtures' worst values moved by chance: grass's shape 0.500 → 0.426 at an inner junction
-/// Imesh sampled anew, coffee's 0.476 → 0.486). Measured and left out: the same floor after a filter of radius 2 (quads of 1.5–2.5 px, where a strip of 2 px
-/// is a quad wide): 48 meshes changed, 30 up and 18 down (mean of the means +0.0009, under 0.5
-/// in shape 16), but a street grid's 2 px band along its border, given away, moved Imesh's
-/// samples and left a sliver at a block's corner (worst scaled Jacobian 0.502 → 0.425), and
-/// aloe's worst scaled Jacobian fell 0.463 → 0.429, coffee's mean 0.911 → 0.908.
+/// Imesh sampled anew, coffee's 0.476 → 0.486). Measured and left out: the same floor after a
+/// filter of radius 2 (quads of 1.5–2.5 px, where a strip of 2 px is a quad wide): 48 meshes
+/// changed, 30 up and 18 down (mean of the means +0.0009, under 0.5 in shape 16), but a street
+/// grid's 2 px band along its border, given away, moved Imesh's samples and left a sliver at a
+/// block's corner (worst scaled Jacobian 0.502 → 0.425), and aloe's worst scaled Jacobian fell
+/// 0.463 → 0.429, coffee's mean 0.911 → 0.908.
 pub const MIN_BORDER_SLIVER_PX: f64 = 1.0;
 
 /// Where simplification brings a vertex of G' closer than this many quad sides to an edge of
