@@ -79,43 +79,65 @@ impl QuadMesh {
         let nv = t.num_vertices() as u32;
         let per_edge = 2 * k - 1;
         let inside_base = nv + per_edge * m.edges.len() as u32;
-        let quad_count = m.quad_count(k) as usize;
-        let mut quads = Vec::with_capacity(quad_count);
-        let mut labels = Vec::with_capacity(quad_count);
-        let mut parents = Vec::with_capacity(quad_count);
+        // Each element's template points, quads and inner vertices take the next places in
+        // element order; their counts depend only on the element's kind, so the places are
+        // known up front and the elements are filled in side by side.
         let mut point_first = Vec::with_capacity(m.elements.len() + 1);
-        point_first.push(0u32);
-        let mut points = Vec::with_capacity(m.elements.len() * templates[1].places.len());
         let mut quad_first = Vec::with_capacity(m.elements.len() + 1);
-        quad_first.push(0u32);
-        let mut next_inside = inside_base;
         let mut inside_first = Vec::with_capacity(m.elements.len() + 1);
-        for (index, element) in m.elements.iter().enumerate() {
+        let (mut point_count, mut quad_count, mut next_inside) = (0u32, 0u32, inside_base);
+        for element in &m.elements {
             let tp = template(element);
-            let corners = element.corners();
-            let start = points.len();
-            for place in &tp.places {
-                let id = match *place {
-                    Place::Corner(c) => corners[c as usize],
-                    Place::Side { side, position } => {
-                        let (e, forward) = m.side_edge(index, side as usize);
-                        let along = if forward { position } else { 2 * k - position };
-                        nv + per_edge * e + along - 1
-                    }
-                    Place::Inside(i) => next_inside + i,
-                };
-                points.push(id);
-            }
+            point_first.push(point_count);
+            quad_first.push(quad_count);
             inside_first.push(next_inside);
+            point_count += tp.places.len() as u32;
+            quad_count += tp.quads.len() as u32;
             next_inside += tp.inside;
-            point_first.push(points.len() as u32);
-            for q in &tp.quads {
-                quads.push(q.map(|i| points[start + i as usize]));
-                labels.push(m.labels[index]);
-                parents.push(index as u32);
-            }
-            quad_first.push(quads.len() as u32);
         }
+        point_first.push(point_count);
+        quad_first.push(quad_count);
+        let mut points = vec![0u32; point_count as usize];
+        let mut quads = vec![[0u32; 4]; quad_count as usize];
+        let mut labels = vec![0u32; quad_count as usize];
+        let mut parents = vec![0u32; quad_count as usize];
+        let spans = |first: &[u32]| -> Vec<(usize, usize)> {
+            first
+                .windows(2)
+                .map(|w| (w[0] as usize, (w[1] - w[0]) as usize))
+                .collect()
+        };
+        let (point_spans, quad_spans) = (spans(&point_first), spans(&quad_first));
+        let point_slices = disjoint_slices(&mut points, point_spans.into_iter());
+        let quad_slices = disjoint_slices(&mut quads, quad_spans.iter().copied());
+        let label_slices = disjoint_slices(&mut labels, quad_spans.iter().copied());
+        let parent_slices = disjoint_slices(&mut parents, quad_spans.into_iter());
+        m.elements
+            .par_iter()
+            .zip(point_slices)
+            .zip(quad_slices.into_par_iter().zip(label_slices))
+            .zip(parent_slices)
+            .enumerate()
+            .for_each(|(index, (((element, ids), (out, label)), parent))| {
+                let tp = template(element);
+                let corners = element.corners();
+                for (id, place) in ids.iter_mut().zip(&tp.places) {
+                    *id = match *place {
+                        Place::Corner(c) => corners[c as usize],
+                        Place::Side { side, position } => {
+                            let (e, forward) = m.side_edge(index, side as usize);
+                            let along = if forward { position } else { 2 * k - position };
+                            nv + per_edge * e + along - 1
+                        }
+                        Place::Inside(i) => inside_first[index] + i,
+                    };
+                }
+                for (quad, q) in out.iter_mut().zip(&tp.quads) {
+                    *quad = q.map(|i| ids[i as usize]);
+                }
+                label.fill(m.labels[index]);
+                parent.fill(index as u32);
+            });
         inside_first.push(next_inside);
         let n = next_inside as usize;
         let mut mesh = Self {
@@ -685,6 +707,71 @@ mod tests {
             prop_assert_eq!(&one.vertices, &all.vertices);
             // The net moved, so the passes had something to change.
             prop_assert!(all.vertices != straight.vertices);
+        }
+
+        /// The templates and the straight net, laid out element by element in parallel, are
+        /// the one-at-a-time layout: each element's template points, quads, labels and
+        /// parents, and its inner vertices and inner control points, follow the previous
+        /// element's; the net's edge points are at a third and two thirds of their edges.
+        #[test]
+        fn templates_and_net_are_laid_out_in_element_order(
+            k in 1u32..4,
+            moves in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 7..40),
+        ) {
+            let (t, m, _, q) = moved(k, &moves, 0.0);
+            let net = ControlNet::straight(&t, &m);
+            let templates = [Template::triangle(k), Template::quad(k)];
+            let nv = t.num_vertices() as u32;
+            let per_edge = 2 * k - 1;
+            let (mut next_inside, mut next_inner) = (nv + per_edge * m.edges.len() as u32, 0);
+            let (mut quads, mut points) = (Vec::new(), Vec::new());
+            let (mut labels, mut parents) = (Vec::new(), Vec::new());
+            for (index, element) in m.elements.iter().enumerate() {
+                let tp = &templates[usize::from(matches!(element, Element::Quad(_)))];
+                let ids: Vec<u32> = tp
+                    .places
+                    .iter()
+                    .map(|place| match *place {
+                        Place::Corner(c) => element.corners()[c as usize],
+                        Place::Side { side, position } => {
+                            let (e, forward) = m.side_edge(index, side as usize);
+                            let along = if forward { position } else { 2 * k - position };
+                            nv + per_edge * e + along - 1
+                        }
+                        Place::Inside(i) => next_inside + i,
+                    })
+                    .collect();
+                next_inside += tp.inside;
+                for quad in &tp.quads {
+                    quads.push(quad.map(|i| ids[i as usize]));
+                    labels.push(m.labels[index]);
+                    parents.push(index as u32);
+                }
+                points.extend(ids);
+                // The patch's inner control points: the next ones after the edges'.
+                let inner: Vec<u32> = net.patches[index]
+                    .iter()
+                    .copied()
+                    .filter(|&c| c != u32::MAX && c >= net.inner_base)
+                    .collect();
+                let expected: Vec<u32> = (0..inner.len() as u32)
+                    .map(|i| net.inner_base + next_inner + i)
+                    .collect();
+                prop_assert_eq!(&inner, &expected);
+                next_inner += inner.len() as u32;
+            }
+            prop_assert_eq!(&q.quads, &quads);
+            prop_assert_eq!(&q.points, &points);
+            prop_assert_eq!(&q.labels, &labels);
+            prop_assert_eq!(&q.parents, &parents);
+            prop_assert_eq!(q.vertices.len(), next_inside as usize);
+            prop_assert_eq!(net.points.len(), (net.inner_base + next_inner) as usize);
+            for (e, &h) in m.edges.iter().enumerate() {
+                let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+                let at = |i: u32| net.points[(net.edge_base + 2 * e as u32 + i) as usize];
+                prop_assert_eq!(at(0), a + (b - a) * (1.0 / 3.0));
+                prop_assert_eq!(at(1), a + (b - a) * (2.0 / 3.0));
+            }
         }
     }
 }

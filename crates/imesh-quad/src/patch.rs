@@ -6,8 +6,10 @@
 //! edge (its inner control points, at 1/3 and 2/3 along the edge's own direction), then each
 //! element's inner ones (1 for a triangle, 4 for a quad).
 
-use imesh_geom::{Point, Triangulation};
+use imesh_geom::{Point, Triangulation, VertexId};
+use rayon::prelude::*;
 
+use crate::mesh::disjoint_slices;
 use crate::pairing::{Element, ElementMesh};
 
 /// Triangle patch slots as `(a, b)`: powers of the weights of corners 1 and 2 (corner 0 has
@@ -39,6 +41,15 @@ const QUAD_SIDES: [[usize; 4]; 4] = [
 /// The inner slots of a quad patch.
 const QUAD_INNER: [usize; 4] = [5, 6, 9, 10];
 
+/// How many inner control points (on no side) `element`'s patch has: a triangle's centre, a
+/// quad's four.
+fn inner_points(element: &Element) -> usize {
+    match element {
+        Element::Triangle(_) => 1,
+        Element::Quad(_) => QUAD_INNER.len(),
+    }
+}
+
 /// The patch slots along side `side` of `element`, from the side's first corner (whose slot
 /// is the first) to the next.
 pub(crate) fn side_slots(element: &Element, side: usize) -> [usize; 4] {
@@ -57,9 +68,9 @@ pub struct ControlNet {
     /// [`TRIANGLE_SLOTS`] order; quads 16, slot `i + 4 j`).
     pub patches: Vec<[u32; 16]>,
     /// Index of the first inner control point of each M edge (`+ 1` is the second).
-    edge_base: u32,
+    pub(crate) edge_base: u32,
     /// Index of the first of the elements' inner control points.
-    inner_base: u32,
+    pub(crate) inner_base: u32,
 }
 
 impl ControlNet {
@@ -67,53 +78,80 @@ impl ControlNet {
     /// a uniform grid, so that every patch is exactly its straight element.
     pub fn straight(t: &Triangulation, m: &ElementMesh) -> Self {
         let nv = t.num_vertices();
-        let mut points: Vec<Point> =
-            Vec::with_capacity(nv + 2 * m.edges.len() + 4 * m.elements.len());
-        points.extend_from_slice(&t.points()[..nv]);
-        let edge_base = points.len() as u32;
-        for &h in &m.edges {
-            let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
-            points.push(a + (b - a) * (1.0 / 3.0));
-            points.push(a + (b - a) * (2.0 / 3.0));
+        // The inner control points of each element follow the edges' in element order (one
+        // for a triangle's centre, four for a quad's): their places are known up front, so the
+        // elements are laid out side by side.
+        let mut inner_first = Vec::with_capacity(m.elements.len());
+        let mut inner_count = 0;
+        for element in &m.elements {
+            inner_first.push(inner_count);
+            inner_count += inner_points(element);
         }
-        let inner_base = points.len() as u32;
-        let mut patches = Vec::with_capacity(m.elements.len());
-        for (k, element) in m.elements.iter().enumerate() {
-            let mut slots = [u32::MAX; 16];
-            let corners = element.corners();
-            let sides: &[[usize; 4]] = match element {
-                Element::Triangle(_) => &TRIANGLE_SIDES,
-                Element::Quad(_) => &QUAD_SIDES,
-            };
-            for (side, along) in sides.iter().enumerate() {
-                let (e, forward) = m.side_edge(k, side);
-                let inner = [edge_base + 2 * e, edge_base + 2 * e + 1];
-                let (first, second) = if forward {
-                    (inner[0], inner[1])
-                } else {
-                    (inner[1], inner[0])
+        let mut points = vec![Point::new(0.0, 0.0); nv + 2 * m.edges.len() + inner_count];
+        let (corners, rest) = points.split_at_mut(nv);
+        corners.copy_from_slice(&t.points()[..nv]);
+        let (edge_points, inner) = rest.split_at_mut(2 * m.edges.len());
+        edge_points
+            .par_chunks_mut(2)
+            .zip(&m.edges)
+            .for_each(|(out, &h)| {
+                let (a, b) = (t.point(t.origin(h)), t.point(t.destination(h)));
+                out[0] = a + (b - a) * (1.0 / 3.0);
+                out[1] = a + (b - a) * (2.0 / 3.0);
+            });
+        let edge_base = nv as u32;
+        let inner_base = (nv + 2 * m.edges.len()) as u32;
+        let slices = disjoint_slices(
+            inner,
+            m.elements
+                .iter()
+                .zip(&inner_first)
+                .map(|(element, &first)| (first, inner_points(element))),
+        );
+        let patches = m
+            .elements
+            .par_iter()
+            .zip(inner_first)
+            .zip(slices)
+            .enumerate()
+            .map(|(k, ((element, first), out))| {
+                let mut slots = [u32::MAX; 16];
+                let corners = element.corners();
+                let sides: &[[usize; 4]] = match element {
+                    Element::Triangle(_) => &TRIANGLE_SIDES,
+                    Element::Quad(_) => &QUAD_SIDES,
                 };
-                slots[along[0]] = corners[side];
-                slots[along[1]] = first;
-                slots[along[2]] = second;
-            }
-            match element {
-                Element::Triangle(c) => {
-                    let p = c.map(|v| points[v as usize]);
-                    slots[5] = points.len() as u32;
-                    points.push((p[0] + p[1] + p[2]) * (1.0 / 3.0));
+                for (side, along) in sides.iter().enumerate() {
+                    let (e, forward) = m.side_edge(k, side);
+                    let inner = [edge_base + 2 * e, edge_base + 2 * e + 1];
+                    let (first, second) = if forward {
+                        (inner[0], inner[1])
+                    } else {
+                        (inner[1], inner[0])
+                    };
+                    slots[along[0]] = corners[side];
+                    slots[along[1]] = first;
+                    slots[along[2]] = second;
                 }
-                Element::Quad(c) => {
-                    let p = c.map(|v| points[v as usize]);
-                    for slot in QUAD_INNER {
-                        let (i, j) = ((slot % 4) as f64 / 3.0, (slot / 4) as f64 / 3.0);
-                        slots[slot] = points.len() as u32;
-                        points.push(bilinear(&p, i, j));
+                let first = inner_base + first as u32;
+                match element {
+                    Element::Triangle(c) => {
+                        let p = c.map(|v| t.point(VertexId::new(v)));
+                        slots[5] = first;
+                        out[0] = (p[0] + p[1] + p[2]) * (1.0 / 3.0);
+                    }
+                    Element::Quad(c) => {
+                        let p = c.map(|v| t.point(VertexId::new(v)));
+                        for (n, slot) in QUAD_INNER.into_iter().enumerate() {
+                            let (i, j) = ((slot % 4) as f64 / 3.0, (slot / 4) as f64 / 3.0);
+                            slots[slot] = first + n as u32;
+                            out[n] = bilinear(&p, i, j);
+                        }
                     }
                 }
-            }
-            patches.push(slots);
-        }
+                slots
+            })
+            .collect();
         Self {
             points,
             patches,
