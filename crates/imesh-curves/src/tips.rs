@@ -604,8 +604,8 @@ fn cut_off(
 
 /// For cut `i` of `cuts` (the cut each edge belongs to in `cut_of`): the vertex it runs from,
 /// and its foot, when it is a square cut shorter than `snap` (from a side's far vertex to a
-/// new vertex on the other side) whose vertex may move onto its foot. The vertex may not be pinned, on the domain's
-/// border, or at another cut or on one of its edges.
+/// new vertex on the other side) whose vertex may move onto its foot: not pinned, not on the
+/// domain's border, and neither at another cut nor on one of its edges.
 fn snap_vertex(
     g: &CurveGraph,
     cuts: &[Cut],
