@@ -466,8 +466,8 @@ fn cut_off(
             cut_of[e as usize] = i;
         }
     }
-    // The vertices moved onto their feet, with their cut.
-    let mut snapped: Vec<(u32, usize)> = Vec::new();
+    // Per vertex of `g`: the cut that moved it onto its foot (usize::MAX for none).
+    let mut snapped = vec![usize::MAX; g.points().len()];
     let mut added = Vec::new();
     let mut cut_ends = Vec::with_capacity(cuts.len());
     let (mut area, mut moved) = (0.0, 0.0f64);
@@ -482,9 +482,11 @@ fn cut_off(
     {
         // A square cut shorter than `snap`: its vertex moves onto its foot, which becomes the
         // vertex where the two sides meet, and no edge is added.
-        let square = snap_vertex(g, cuts, &cut_of, i, snap).filter(|&(v, to)| {
-            snaps[i] && polygon_area(outline).abs() + swept(g, tip, v, to) > 0.0
-        });
+        let piece = polygon_area(outline).abs();
+        let square = snap_vertex(g, cuts, &cut_of, i, snap)
+            .filter(|_| snaps[i])
+            .map(|(v, to)| (v, to, swept(g, tip, v, to)))
+            .filter(|&(_, _, swept)| piece + swept > 0.0);
         let mut ids = [0; 2];
         for (k, (end, &p)) in tip.ends.iter().zip(cut).enumerate() {
             // A side taken whole now bounds the receiver, if anything.
@@ -492,7 +494,7 @@ fn cut_off(
             match (tip.cut[k], tip.next[k]) {
                 (CutEnd::Along(_), _) => {
                     ids[k] = match square {
-                        Some((v, _)) => {
+                        Some((v, _, _)) => {
                             points[v as usize] = p;
                             v
                         }
@@ -515,15 +517,15 @@ fn cut_off(
             }
         }
         cut_ends.push(ids);
-        area += polygon_area(outline).abs();
+        area += piece;
         // The farthest the boundary moved: its farthest vertex cut off from the cut's line.
         let across = cut[1] - cut[0];
         for &q in outline {
             moved = moved.max(cross(across, q - cut[0]).abs() / norm(across));
         }
-        if let Some((v, to)) = square {
-            area += swept(g, tip, v, to);
-            snapped.push((v, i));
+        if let Some((v, to, swept)) = square {
+            area += swept;
+            snapped[v as usize] = i;
             moved = moved.max(norm(to - g.point(v)));
             continue;
         }
@@ -565,11 +567,10 @@ fn cut_off(
     }
     // The edges that met a moved vertex follow it (their tangents kept there); they belong to
     // its cut, which a crossing they make drops.
-    for &(v, i) in &snapped {
-        let p = points[v as usize];
-        for ((e, c), o) in edges.iter().zip(&mut new_curves).zip(&mut owner) {
-            if let Some(end) = e.ends.iter().position(|&x| x == v) {
-                *c = moved_end(*c, 3 * end, p);
+    for ((e, c), o) in edges.iter().zip(&mut new_curves).zip(&mut owner) {
+        for (end, &v) in e.ends.iter().enumerate() {
+            if let Some(&i) = snapped.get(v as usize).filter(|&&i| i != usize::MAX) {
+                *c = moved_end(*c, 3 * end, points[v as usize]);
                 *o = i;
             }
         }
