@@ -1787,7 +1787,11 @@ mod tests {
         let new = g.points().len() as u32;
         assert_eq!(b.graph.points().len(), g.points().len() + 1);
         assert_eq!(b.graph.valence(new), 0);
-        assert!(b.graph.edges().iter().any(|e| e.ends == [4, 1] || e.ends == [1, 4]));
+        assert!(b
+            .graph
+            .edges()
+            .iter()
+            .any(|e| e.ends == [4, 1] || e.ends == [1, 4]));
         for (label, sector) in sectors_at(&b.graph, 4) {
             let least = if label == 1 { 90.0 } else { 30.0 };
             assert!(sector >= least, "{label}: {sector}");
