@@ -362,7 +362,8 @@ fn merge_stubs(b: Blunted, first_new: usize, options: &TipOptions) -> Blunted {
         let &[e0, e1] = g.incident(v) else {
             continue;
         };
-        // Both walked through `v` (into it, then out of it): the same regions on each side.
+        // Both walked through `v` (into it, then out of it): the same regions on each side,
+        // neither the outside (the domain's border stays where it is).
         let walked_in = |e: u32| {
             let edge = g.edges()[e as usize];
             if edge.ends[1] == v {
@@ -372,7 +373,11 @@ fn merge_stubs(b: Blunted, first_new: usize, options: &TipOptions) -> Blunted {
             }
         };
         let ((a, labels_in), (c, [right, left])) = (walked_in(e0), walked_in(e1));
-        if labels_in != [left, right] || taken[e0 as usize] || taken[e1 as usize] {
+        if labels_in != [left, right]
+            || labels_in.contains(&OUTSIDE)
+            || taken[e0 as usize]
+            || taken[e1 as usize]
+        {
             continue;
         }
         let p = g.point(v);

@@ -158,12 +158,34 @@ pub const MIN_PIECE: f64 = 1.0;
 /// 17 (Voronoi grains 0.500 → 0.404).
 pub const LINK_SHARE: f64 = 0.75;
 
-/// The automatic [`MeshOptions::min_width`], as a share of the quad size: a region thinner than
-/// half a quad can only be filled with quads of a fraction of the mean area.
+/// The narrowest region the automatic quad size heeds, as a share of [`MIN_AUTO_SIZE`] (twice
+/// this times that, in pixels, is the least width it weighs).
 pub const AUTO_MIN_WIDTH: f64 = 0.5;
 
+/// The automatic [`MeshOptions::min_width`], as a share of the finest quad side the mesh can
+/// end with (the given `--size`; with `--size auto`, the chosen side refined as far as the band
+/// limit may, [`AUTO_BAND_REFINEMENT`], and not below [`MIN_AUTO_SIZE`]): regions thinner are
+/// merged into their neighbours. DT' fills a strip `d` wide with triangles whose corners stay
+/// over 20.7°, about `2.6 d²` in area, and their template quads come to about `1.3 (d / q)²`
+/// of the mean area: a region under three quarters of a quad holds quads of about 0.7 of it at
+/// best, whose shape-and-size is about half their shape. Measured with the defaults (`cargo
+/// xtask bench random`, 150 images a set; half a quad side of the chosen size before):
+/// seed 52 26 meshes changed, 24 up (mean of the means 0.89354 → 0.89383, quads under 0.25
+/// 3 608 → 3 413); seed 101 30, 25 up (0.90061 → 0.90087, 5 185 → 4 985); seed 202 33, 31 up
+/// (0.89582 → 0.89607, 4 093 → 3 887); seed 303 at `--size 3` 45, 43 up (0.85824 → 0.85957,
+/// 12 317 → 11 418); quads under 0.5 in shape 187 against 189 over the five sets (seed 52 at
+/// `--size 3` too), in scaled Jacobian 20 against 25. Of the fixtures, the six whose chosen
+/// side is under 3 px changed, every mean up (grass 0.705 → 0.719, pyvista 0.875 → 0.885,
+/// coffee 0.912 → 0.918, aloe 0.769 → 0.775, gravel 0.719 → 0.724, brick +0.0002), label
+/// agreement 0.01–0.4 points lower; worst shape pyvista 0.500 → 0.459, aloe 0.412 → 0.384,
+/// grass 0.389 → 0.405. A share of 1.0 raised the means further (seed 52 0.89442, seed 303
+/// at `--size 3` 0.86116) by dropping more of the image. Three quarters of the chosen side,
+/// with the narrowest width the automatic size weighs raised to match ([`AUTO_MIN_WIDTH`]),
+/// coarsened coffee's quads (2.0 → 2.9 px, mean 0.912 → 0.908).
+pub const THIN_REGION_SHARE: f64 = 0.75;
+
 /// After the majority filter, the parts of regions thinner than twice this share of its radius
-/// (the radius is about a quad side: half a quad, as [`AUTO_MIN_WIDTH`]) only because they lie
+/// (the radius is about a quad side: half a quad) only because they lie
 /// against the image's border, each of at least a quad's area, are given to their neighbours
 /// ([`imesh_classify::remove_border_slivers`]). The filter's window is cut off at the border,
 /// and where a region nearly touches the border the gap tapering between them kept its pixels
@@ -364,8 +386,8 @@ pub struct MeshOptions {
     pub size: ElementSize,
     /// Regions of the partition thinner than this many pixels (twice their area over their
     /// perimeter) are merged into the neighbour they share the longest boundary with, on the
-    /// quad path: `None` (auto) is half the quad size of a uniform mesh and nothing for a
-    /// graded one; 0 keeps every region.
+    /// quad path: `None` (auto) is [`THIN_REGION_SHARE`] of the finest quad side a uniform mesh
+    /// can end with and nothing for a graded one; 0 keeps every region.
     pub min_width: Option<f64>,
     /// Regions (4-connected) smaller than this many pixels are merged into the neighbour they
     /// share the longest border with before meshing (0: every region is kept).
@@ -1170,7 +1192,7 @@ impl Pipeline {
         let mut label = partition(grid, &sampling.triangulation);
         let min_width = o
             .min_width
-            .unwrap_or_else(|| quad_size.map_or(0.0, |q| AUTO_MIN_WIDTH * q));
+            .unwrap_or_else(|| quad_size.map_or(0.0, |q| self.auto_min_width(q)));
         let (w, h) = (grid.width(), grid.height());
         let mut merged = match o.elements {
             Elements::Quad => merge_thin_regions(&sampling.triangulation, &mut label, min_width),
@@ -1800,6 +1822,18 @@ impl Pipeline {
                 Some(by_count.min(by_width).max(MIN_AUTO_SIZE))
             }
         }
+    }
+
+    /// The automatic `min_width` for quads of side `q` chosen from the image (or given):
+    /// [`THIN_REGION_SHARE`] of the finest side the mesh can end with (with `--size auto`, the
+    /// band limit may refine `q` down to `q /` [`AUTO_BAND_REFINEMENT`], never below
+    /// [`MIN_AUTO_SIZE`]).
+    fn auto_min_width(&self, q: f64) -> f64 {
+        let finest = match self.options.size {
+            ElementSize::Auto => (q / AUTO_BAND_REFINEMENT).max(MIN_AUTO_SIZE.min(q)),
+            _ => q,
+        };
+        THIN_REGION_SHARE * finest
     }
 
     fn refinement_cap(&self) -> usize {
@@ -2435,6 +2469,26 @@ fn agreement(
 mod tests {
     use super::*;
 
+    /// The automatic thin-region width is three quarters of the finest quad side: the given
+    /// size, or the chosen one refined as far as the band limit may (a 1.5th), not below the
+    /// 2 px floor nor above the chosen side; an explicit width is kept.
+    #[test]
+    fn thin_regions_are_measured_against_the_finest_quad() {
+        let width = |size: ElementSize, q: f64| {
+            Pipeline::new(MeshOptions {
+                size,
+                ..MeshOptions::default()
+            })
+            .auto_min_width(q)
+        };
+        for (q, finest) in [(2.0, 2.0), (2.4, 2.0), (4.5, 3.0), (9.0, 6.0), (1.5, 1.5)] {
+            let w = width(ElementSize::Auto, q);
+            assert!((w - THIN_REGION_SHARE * finest).abs() < 1e-12, "{q}: {w}");
+        }
+        assert!((width(ElementSize::Pixels(3.0), 3.0) - 2.25).abs() < 1e-12);
+        assert!((width(ElementSize::Pixels(1.0), 1.0) - 0.75).abs() < 1e-12);
+    }
+
     /// A `side` × `side` square image cut by `cuts` vertical boundaries, as G'.
     fn striped(side: f64, cuts: u32) -> CurveGraph {
         let mut points = vec![imesh_geom::Point::new(0.0, 0.0)];
@@ -2511,7 +2565,7 @@ mod tests {
         let q = pipeline.quad_size(&grid).unwrap();
         let (grid, _) = pipeline.clean_up(&grid, auto_majority(q)).unwrap();
         let sampling = sample(&grid, &SampleOptions::default()).unwrap();
-        let min_width = AUTO_MIN_WIDTH * q;
+        let min_width = pipeline.auto_min_width(q);
         let mut label = partition(&grid, &sampling.triangulation);
         merge_thin_regions(&sampling.triangulation, &mut label, min_width);
         (pipeline, grid, sampling, label, q, min_width)

@@ -144,8 +144,8 @@ struct MeshFlags {
     #[arg(long)]
     majority: Option<AutoOr<u32>>,
     /// Merge regions thinner than this many pixels (twice their area over their perimeter) into
-    /// their neighbour (quads); 0 keeps every region [default: auto, half the quad side for
-    /// uniform quads, none otherwise].
+    /// their neighbour (quads); 0 keeps every region [default: auto, three quarters of the
+    /// finest quad side for uniform quads (1.5 px at the 2 px floor), none otherwise].
     #[arg(long)]
     min_width: Option<AutoOr<f64>>,
     /// Keep the regions' tips sharper than 30° as the image has them (the quad there keeps a

@@ -311,8 +311,12 @@ fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
     // The size from the quad count alone (coins' regions are wide): the clean-ups' size, and
     // the mesh's before the boundaries were measured.
     let by_count = (384.0 * 303.0 / imesh::AUTO_QUADS).sqrt();
+    // With the automatic size, regions are merged below three quarters of the finest side it
+    // may refine to; the coarse run is given the same width.
+    let finest = (by_count / imesh::AUTO_BAND_REFINEMENT).max(imesh::MIN_AUTO_SIZE);
     let coarse = run(MeshOptions {
         size: ElementSize::Pixels(by_count),
+        min_width: Some(imesh::THIN_REGION_SHARE * finest),
         ..Default::default()
     });
     let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
