@@ -1255,6 +1255,14 @@ mod tests {
         b
     }
 
+    /// The edge from `a` to `b` with `labels` (left, right).
+    fn e(a: u32, b: u32, labels: [u32; 2]) -> GraphEdge {
+        GraphEdge {
+            ends: [a, b],
+            labels,
+        }
+    }
+
     /// Straight curves for every edge of `g`.
     fn straight(g: &CurveGraph) -> Vec<CubicBezier> {
         g.edges()
@@ -1321,10 +1329,6 @@ mod tests {
             at(-s, s),
         ];
         let below = if junction { 2 } else { 0 };
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         // Each label on the left of its edge's direction.
         let mut edges = vec![
             e(0, 1, [1, below]),
@@ -1577,10 +1581,6 @@ mod tests {
             Point::new(40.0, 40.0),
             Point::new(0.0, 40.0),
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         let edges = vec![
             e(0, 1, [1, OUTSIDE]),
             e(1, 2, [1, 0]),
@@ -1634,10 +1634,6 @@ mod tests {
         let mut points: Vec<Point> = outline.iter().map(|&p| at(p)).collect();
         points.extend([(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| at(Point::new(x, y))));
         let n = outline.len() as u32;
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         let mut edges: Vec<GraphEdge> = (0..n).map(|k| e(k, (k + 1) % n, [1, 0])).collect();
         edges.extend((0..4).map(|k| e(n + k, n + (k + 1) % 4, [0, OUTSIDE])));
         let g = CurveGraph::new(points, edges).ok()?;
@@ -1868,10 +1864,6 @@ mod tests {
             Point::new(40.0, 20.0),
             Point::new(-20.0, 20.0),
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         let edges = vec![
             e(1, 0, [1, 0]),
             e(0, 2, [1, 0]),
@@ -2133,10 +2125,6 @@ mod tests {
             p(5.0, 12.0),   // R
             p(-30.0, 12.0), // S
         ];
-        let e = |a, b, labels| GraphEdge {
-            ends: [a, b],
-            labels,
-        };
         let edges = vec![
             e(1, 0, [1, 0]),
             e(0, 2, [1, 2]),
@@ -2189,10 +2177,6 @@ mod tests {
                 Point::new(-10.0, 0.0),
                 other,
             ];
-            let e = |a, b, labels| GraphEdge {
-                ends: [a, b],
-                labels,
-            };
             let edges = vec![
                 e(3, 0, [1, 0]),
                 e(0, 1, [1, 0]),
