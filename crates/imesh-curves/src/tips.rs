@@ -16,7 +16,8 @@
 //! a square cut under half a quad side is made by moving that end onto its foot, unless that
 //! would leave a corner as sharp, rather than by an edge a fraction of a quad long); a tip
 //! both of whose sides end that early, between their ends; and a spike that stays narrow one
-//! vertex further (a pixel staircase), from that vertex.
+//! vertex further (a pixel staircase), from that vertex. A cut's end that later cuts leave on
+//! a stub under three quarters of a quad side merges into the stub's other end.
 
 use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
@@ -2259,7 +2260,7 @@ mod tests {
                 prop_assert!((before[&1] - after[&1] - b.area).abs() < 1e-9 * scale);
                 prop_assert!(b.area > 0.0);
                 // The cut's new vertices: region 1 keeps 90° or more at each, every region
-                // 30° or more; where the cut, narrower than half a width, merged one into the
+                // 30° or more; where the cut, narrower than [`MERGED_STUB`], merged one into the
                 // other (the lower side then runs from the upper side's cut), 30° or more.
                 let made = g.points().len() as u32..b.graph.points().len() as u32;
                 let merged = made.clone().any(|v| b.graph.valence(v) == 0);
