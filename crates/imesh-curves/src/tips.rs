@@ -404,10 +404,10 @@ fn merge_stubs(b: Blunted, first_new: usize, options: &TipOptions) -> Blunted {
             .incident(to)
             .iter()
             .any(|&e| g.edges()[e as usize].ends.contains(&far));
-        let area = 0.5 * cross(p - g.point(far), g.point(to) - g.point(far)).abs();
         if la.min(lc) >= snap || to == far || duplicate || g.is_pinned(v) {
             continue;
         }
+        let area = 0.5 * cross(p - g.point(far), g.point(to) - g.point(far)).abs();
         taken[short as usize] = true;
         taken[long as usize] = true;
         stubs.push(Stub {
@@ -453,14 +453,9 @@ fn merge_stubs(b: Blunted, first_new: usize, options: &TipOptions) -> Blunted {
             }
             owner.push(i);
         }
-        let Ok(mut graph) = CurveGraph::new(g.points().to_vec(), edges) else {
+        let Some(graph) = with_pins_of(g, g.points().to_vec(), edges) else {
             return b;
         };
-        for v in 0..g.points().len() as u32 {
-            if g.is_pinned(v) && graph.pin(v).is_err() {
-                return b;
-            }
-        }
         let mut refused: Vec<usize> = match graph.crossing() {
             Some(pair) => {
                 let crossing: Vec<usize> = pair
@@ -752,12 +747,7 @@ fn cut_off(
             }
         }
     }
-    let mut graph = CurveGraph::new(points, edges).map_err(|_| Vec::new())?;
-    for v in 0..g.points().len() as u32 {
-        if g.is_pinned(v) {
-            graph.pin(v).map_err(|_| Vec::new())?;
-        }
-    }
+    let graph = with_pins_of(g, points, edges).ok_or_else(Vec::new)?;
     // Each cut lies in its own piece, which holds no vertex; two tips of one region folded
     // onto each other could still overlap.
     if let Some(pair) = graph.crossing() {
@@ -778,6 +768,16 @@ fn cut_off(
         moved,
     };
     Ok((blunted, cut_ends))
+}
+
+/// The graph of `points` and `edges` (which keep `g`'s vertices first) with `g`'s vertices
+/// pinned where they were; `None` where it is not a graph.
+fn with_pins_of(g: &CurveGraph, points: Vec<Point>, edges: Vec<GraphEdge>) -> Option<CurveGraph> {
+    let mut graph = CurveGraph::new(points, edges).ok()?;
+    for v in (0..g.points().len() as u32).filter(|&v| g.is_pinned(v)) {
+        graph.pin(v).ok()?;
+    }
+    Some(graph)
 }
 
 /// For cut `i` of `cuts` (the cut each edge belongs to in `cut_of`): the vertex it runs from,
