@@ -3,10 +3,11 @@
 
 use crate::graph::{CurveGraph, GraphEdge};
 
-/// A simple open chain of graph vertices between two cut vertices.
+/// A simple chain of graph vertices between two cut vertices (open, but for the joined pieces
+/// of a loop in [`crate::Simplification::polylines`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Polyline {
-    /// Its vertices in order (at least two, all distinct).
+    /// Its vertices in order (at least two, all distinct but for a closed one's ends).
     pub vertices: Vec<u32>,
     /// The graph edge between `vertices[i]` and `vertices[i + 1]`.
     pub edges: Vec<u32>,
@@ -48,11 +49,31 @@ impl Polyline {
 /// # Ok::<(), imesh_curves::CurveError>(())
 /// ```
 pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
+    polylines_and_loops(g).0
+}
+
+/// A closed curve that [`polylines`] cut into three pieces: the pieces are `lines[first]`,
+/// `lines[first + 1]` and `lines[first + 2]`, each starting where the one before ends, the
+/// third ending where the first starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct CutLoop {
+    /// The index of the first piece.
+    pub first: usize,
+    /// True when the loop's start is a cut of its own too (a loop of valence-2 vertices, started
+    /// at its lowest-then-leftmost vertex); false when it starts at a vertex that ends
+    /// polylines anyway (a loop hanging off a junction or a pinned vertex).
+    pub closed: bool,
+}
+
+/// [`polylines`], with the closed curves it cut into three pieces: those cuts are the
+/// polylines' only ends that the graph does not make (see [`CutLoop`]).
+pub(crate) fn polylines_and_loops(g: &CurveGraph) -> (Vec<Polyline>, Vec<CutLoop>) {
     let n = g.points().len() as u32;
     let edges = g.edges();
     let through = Through::new(g);
     let mut used = vec![false; edges.len()];
     let mut lines = Vec::new();
+    let mut loops = Vec::new();
     let mut scratch = Polyline {
         vertices: Vec::new(),
         edges: Vec::new(),
@@ -68,6 +89,10 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
                 let [a, b] = scratch.ends();
                 if a == b {
                     // A loop hanging off a cut vertex: cut it too, keeping that vertex an end.
+                    loops.push(CutLoop {
+                        first: lines.len(),
+                        closed: false,
+                    });
                     lines.extend(cut_loop(g, &scratch, false));
                 } else {
                     lines.push(scratch.clone());
@@ -79,10 +104,14 @@ pub fn polylines(g: &CurveGraph) -> Vec<Polyline> {
     for e in 0..edges.len() {
         if !used[e] {
             through.walk(g, &mut used, edges[e].ends[0], e as u32, &mut scratch);
+            loops.push(CutLoop {
+                first: lines.len(),
+                closed: true,
+            });
             lines.extend(cut_loop(g, &scratch, true));
         }
     }
-    lines
+    (lines, loops)
 }
 
 /// `e` walked so that `v` is its end (`leaving == false`) or its start (`leaving == true`).
