@@ -696,6 +696,17 @@ fn a_thin_wedge_at_a_junction_is_a_neck() {
         .is_empty());
 }
 
+/// `g` simplified at `tolerance` with pieces of at least `min_length`, checked against `g`.
+fn checked_simplify(g: &CurveGraph, tolerance: f64, min_length: f64) -> Simplification {
+    let options = SimplifyOptions {
+        tolerance,
+        min_length,
+    };
+    let s = simplify(g, &options).unwrap();
+    check_simplification(g, &s, tolerance.max(0.5 * min_length));
+    s
+}
+
 #[test]
 fn a_loop_s_cuts_beside_short_pieces_are_freed() {
     // Coins' island near pixel (40, 264) as its pixel-boundary loop (shifted to the origin).
@@ -719,15 +730,7 @@ fn a_loop_s_cuts_beside_short_pieces_are_freed() {
     ];
     let g = loop_graph(corners.iter().map(|&(x, y)| Point::new(x, y)).collect());
     let run = |min_length: f64| {
-        let s = simplify(
-            &g,
-            &SimplifyOptions {
-                tolerance: 2.0,
-                min_length,
-            },
-        )
-        .unwrap();
-        check_simplification(&g, &s, 2.0_f64.max(0.5 * min_length));
+        let s = checked_simplify(&g, 2.0, min_length);
         let kept: Vec<u32> = (0..corners.len() as u32)
             .filter(|&v| s.graph.valence(v) > 0)
             .collect();
@@ -765,21 +768,9 @@ fn a_hanging_loop_keeps_its_junction_when_a_cut_is_freed() {
     let mut edges: Vec<GraphEdge> = (0..8u32).map(|i| edge(i, (i + 1) % 8, [1, 0])).collect();
     edges.push(edge(0, 8, [0, 0]));
     let g = CurveGraph::new(points, edges).unwrap();
-    let run = |min_length: f64| {
-        let s = simplify(
-            &g,
-            &SimplifyOptions {
-                tolerance: 0.5,
-                min_length,
-            },
-        )
-        .unwrap();
-        check_simplification(&g, &s, 0.5_f64.max(0.5 * min_length));
-        s
-    };
-    let s = run(0.0);
+    let s = checked_simplify(&g, 0.5, 0.0);
     assert!(s.graph.valence(3) == 2 && s.graph.is_pinned(3));
-    let s = run(2.5);
+    let s = checked_simplify(&g, 0.5, 2.5);
     let kept: Vec<u32> = (0..9).filter(|&v| s.graph.valence(v) > 0).collect();
     assert_eq!(kept, [0, 2, 4, 6, 8]);
     assert_eq!(s.polylines.len(), 3, "the tail and the square's two lines");
