@@ -65,6 +65,12 @@ impl SimplifyOptions {
             ..Self::default()
         }
     }
+
+    /// How far the third pass's chords (and a freed loop cut's) may stray from the original
+    /// vertices: the larger of the tolerance and half [`SimplifyOptions::min_length`].
+    fn join_deviation(&self) -> f64 {
+        self.tolerance.max(0.5 * self.min_length)
+    }
 }
 
 impl Default for SimplifyOptions {
@@ -347,8 +353,7 @@ impl<'a> State<'a> {
         let kept = if kept.len() <= 2 || options.min_length <= 0.0 {
             kept
         } else {
-            let deviation = tolerance.max(0.5 * options.min_length);
-            self.join_short_pieces(line, kept, &mut scratch, options.min_length, deviation)
+            self.join_short_pieces(line, kept, &mut scratch, options)
         };
         self.scratch = scratch;
         kept
@@ -493,8 +498,8 @@ impl<'a> State<'a> {
     /// indices.
     fn free_loop_cuts(
         &mut self,
-        mut lines: Vec<Polyline>,
-        mut kept: Vec<Vec<usize>>,
+        lines: Vec<Polyline>,
+        kept: Vec<Vec<usize>>,
         loops: &[CutLoop],
         options: &SimplifyOptions,
     ) -> (Vec<Polyline>, Vec<Vec<usize>>) {
@@ -502,23 +507,16 @@ impl<'a> State<'a> {
             return (lines, kept);
         }
         let mut scratch = std::mem::take(&mut self.scratch);
-        let (mut out_lines, mut out_kept) = (Vec::new(), Vec::new());
+        let mut out = Vec::with_capacity(lines.len());
         let mut next_loop = loops.iter().peekable();
-        let mut i = 0;
-        while i < lines.len() {
+        let mut input = lines.into_iter().zip(kept).enumerate();
+        while let Some((i, line)) = input.next() {
             let Some(l) = next_loop.next_if(|l| l.first == i) else {
-                out_lines.push(std::mem::replace(&mut lines[i], empty_line()));
-                out_kept.push(std::mem::take(&mut kept[i]));
-                i += 1;
+                out.push(line);
                 continue;
             };
-            let mut pieces: Vec<(Polyline, Vec<usize>)> = (i..i + 3)
-                .map(|k| {
-                    (
-                        std::mem::replace(&mut lines[k], empty_line()),
-                        std::mem::take(&mut kept[k]),
-                    )
-                })
+            let mut pieces: Vec<(Polyline, Vec<usize>)> = std::iter::once(line)
+                .chain(input.by_ref().take(2).map(|(_, piece)| piece))
                 .collect();
             // cut[j]: the end of pieces[j] (the start of the next) is a cut of ours.
             let mut cut = vec![true, true, l.closed];
@@ -526,7 +524,10 @@ impl<'a> State<'a> {
             while let Some((j, curve, deviation)) =
                 self.freest_cut(&pieces, &cut, l.closed, options)
             {
+                // The joined piece ends where the right one did.
                 let next = (j + 1) % pieces.len();
+                cut[j] = cut[next];
+                cut.remove(next);
                 let (right, right_kept) = pieces.remove(next);
                 let j = if next < j { j - 1 } else { j };
                 let (left, left_kept) = &mut pieces[j];
@@ -535,8 +536,6 @@ impl<'a> State<'a> {
                 left_kept.extend(right_kept[1..].iter().map(|&k| k + shift));
                 left.vertices.extend_from_slice(&right.vertices[1..]);
                 left.edges.extend_from_slice(&right.edges);
-                cut[j] = cut[next];
-                cut.remove(next);
                 self.replace(&curve, left_kept.len() == 2);
                 self.max_deviation = self.max_deviation.max(deviation);
                 self.merged += 1;
@@ -544,24 +543,15 @@ impl<'a> State<'a> {
             }
             for (line, line_kept) in pieces {
                 let line_kept = if joined && options.min_length > 0.0 && line_kept.len() > 2 {
-                    let deviation = options.tolerance.max(0.5 * options.min_length);
-                    self.join_short_pieces(
-                        &line,
-                        line_kept,
-                        &mut scratch,
-                        options.min_length,
-                        deviation,
-                    )
+                    self.join_short_pieces(&line, line_kept, &mut scratch, options)
                 } else {
                     line_kept
                 };
-                out_lines.push(line);
-                out_kept.push(line_kept);
+                out.push((line, line_kept));
             }
-            i += 3;
         }
         self.scratch = scratch;
-        (out_lines, out_kept)
+        out.into_iter().unzip()
     }
 
     /// The cut of [`State::free_loop_cuts`] to free next among a loop's `pieces` (each a
@@ -584,7 +574,7 @@ impl<'a> State<'a> {
         let points = self.g().points();
         // A cut next to a short piece, joined as the third pass joins short pieces.
         let short = options.min_length * options.min_length;
-        let bar = options.tolerance.max(0.5 * options.min_length);
+        let bar = options.join_deviation();
         let mut best: Option<(usize, [u32; 3], f64)> = None;
         let mut own = Vec::new();
         for j in (0..pieces.len()).filter(|&j| cut[j]) {
@@ -616,19 +606,19 @@ impl<'a> State<'a> {
         best
     }
 
-    /// The third pass over a simplified polyline: a piece shorter than `min_length` loses one of
-    /// its inner ends (the one whose removal keeps the joined chord closer to the original
-    /// vertices, within `tolerance`, and passes the topology test), until no short piece can be
-    /// joined. The polyline's own ends (junctions, the domain's corners) stay. Returns the kept
+    /// The third pass over a simplified polyline: a piece shorter than `options.min_length`
+    /// loses one of its inner ends (the one whose removal keeps the joined chord closer to the
+    /// original vertices, within the third pass's deviation, and passes the topology test),
+    /// until no short piece can be joined. The polyline's own ends (junctions, the domain's corners) stay. Returns the kept
     /// indices left.
     fn join_short_pieces(
         &mut self,
         line: &Polyline,
         mut kept: Vec<usize>,
         scratch: &mut Scratch,
-        min_length: f64,
-        tolerance: f64,
+        options: &SimplifyOptions,
     ) -> Vec<usize> {
+        let (min_length, tolerance) = (options.min_length, options.join_deviation());
         let curve = &mut scratch.curve;
         let v = &line.vertices;
         let points = self.g().points();
@@ -724,15 +714,6 @@ struct Scratch {
     stack: Vec<(usize, usize)>,
     /// A curve under test (vertex ids).
     curve: Vec<u32>,
-}
-
-/// A placeholder for a polyline moved out of its vector.
-fn empty_line() -> Polyline {
-    Polyline {
-        vertices: Vec::new(),
-        edges: Vec::new(),
-        labels: [0, 0],
-    }
 }
 
 /// An edge's ends, lower id first.

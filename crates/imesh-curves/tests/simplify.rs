@@ -746,6 +746,24 @@ fn a_loop_s_cuts_beside_short_pieces_are_freed() {
     assert_eq!(s.merged, 2);
     // Only the start is pinned now.
     assert!(s.graph.is_pinned(1) && !s.graph.is_pinned(5) && !s.graph.is_pinned(9));
+
+    // Three such islands side by side: each loses the same two cuts.
+    let n = corners.len() as u32;
+    let mut points = Vec::new();
+    let mut edges = Vec::new();
+    for island in 0..3u32 {
+        let dx = 20.0 * f64::from(island);
+        points.extend(corners.iter().map(|&(x, y)| Point::new(x + dx, y)));
+        edges.extend((0..n).map(|i| edge(island * n + i, island * n + (i + 1) % n, [1, 0])));
+    }
+    let g = CurveGraph::new(points, edges).unwrap();
+    let s = checked_simplify(&g, 2.0, 3.5);
+    let kept: Vec<u32> = (0..3 * n).filter(|&v| s.graph.valence(v) > 0).collect();
+    let expected: Vec<u32> = (0..3)
+        .flat_map(|island| [0, 1, 4, 8].map(|v| island * n + v))
+        .collect();
+    assert_eq!(kept, expected);
+    assert_eq!(s.polylines.len(), 3);
 }
 
 #[test]
