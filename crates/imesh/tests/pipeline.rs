@@ -178,11 +178,14 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         let shape = r.quality.shape().min;
         let bound = if path.ends_with("opencv-aloeGT.png") {
             0.25
-        } else if path.ends_with("skimage-grass.png") {
-            // 0.347 since thin strips' boundary pieces are cut to the strips' depth (session
-            // 43): a boundary quad at (270.5, 485.5) that other changes moved between 0.30 and
-            // 0.42.
-            0.3
+        } else if path.ends_with("skimage-grass.png") || path.ends_with("skimage-gravel.png") {
+            // Grass 0.347 since thin strips' boundary pieces are cut to the strips' depth
+            // (session 43): a boundary quad at (270.5, 485.5) that other changes moved between
+            // 0.30 and 0.42. Since session 57's lattice tries (both lattices × 0.909, 5–8 % more
+            // quads) grass 0.429 → 0.233, a quad at a junction of four blades near (297.5,
+            // 315.5), and gravel 0.500 → 0.313, a quad in a sliver's wedge near (444, 27); over
+            // 1 050 random images the quads under 0.5 in shape went 204 → 158.
+            0.2
         } else {
             0.4
         };
@@ -341,8 +344,9 @@ fn the_automatic_size_is_finer_where_boundaries_would_take_too_many_quads() {
 }
 
 /// Where the band along the boundaries pulls the mean quad area off the lattice's (the camera:
-/// the median quad, a lattice one, is 1.015 times the mean), the lattice is scaled to match and
-/// kept for its higher shape-and-size; where the lattice fits (MRI, to 0.1 %), it stays.
+/// the median quad, a lattice one, is 1.013 times the mean at first; the MRI scan 1.007), the
+/// lattice is scaled towards the mean, twice at most, and the best try kept for its higher
+/// shape-and-size; where the lattice fits (pyvista's channels, within 0.2 %), it stays.
 /// (Pyvista's channels were the scaled example, 0.971 and then 0.987 of the mean, until the
 /// matching left its large band pairs as triangles: their quads, two thirds as large, bring the
 /// mean to the lattice's.)
@@ -357,28 +361,29 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     let mean = |r: &imesh::Report| r.quality.shape_and_size().map_or(0.0, |s| s.mean);
     let camera = run("skimage-camera.png");
     let mri = run("matplotlib-s1045_mri.png");
+    let pyvista = run("pyvista-channels_z050_labels.png");
     eprintln!(
-        "camera: lattice × {:.4}, mean S&S {:.4}; MRI: × {:.4}, {:.4}",
+        "camera: lattice × {:.4}, mean S&S {:.4}; MRI: × {:.4}, {:.4}; pyvista: × {:.4}, {:.4}",
         camera.counts.lattice_scale,
         mean(&camera),
         mri.counts.lattice_scale,
-        mean(&mri)
+        mean(&mri),
+        pyvista.counts.lattice_scale,
+        mean(&pyvista)
     );
-    assert!(camera.validation.valid && mri.validation.valid);
-    assert!((0.97..=0.995).contains(&camera.counts.lattice_scale));
-    assert!(mean(&camera) >= 0.9, "{}", mean(&camera));
-    assert_eq!(mri.counts.lattice_scale, 1.0);
-    // 0.9086 since thin strips' pieces are cut (0.9113 before): a strip-shaped island's
-    // shorter pieces make the band outside it finer; 0.9048 since unpaired triangles sharp
-    // beside a boundary are refined once more (0.9072 before: 3 points, 12 more quads, so a
-    // mean quad area 0.12 % lower, against which every lattice square scores 0.9976); 0.9039
-    // since the matching leaves the triangles at a wide pinned corner with unequal sides (three
-    // pairs: 6 more quads, the same mechanism).
-    assert!(mean(&mri) >= 0.903);
+    assert!(camera.validation.valid && mri.validation.valid && pyvista.validation.valid);
+    // Session 56's single try of the plain ratio: camera × 0.987, 0.9139; MRI × 1 (it was
+    // within 1 %), 0.9052.
+    assert!((0.93..=0.97).contains(&camera.counts.lattice_scale));
+    assert!(mean(&camera) >= 0.92, "{}", mean(&camera));
+    assert!((0.93..=0.99).contains(&mri.counts.lattice_scale));
+    assert!(mean(&mri) >= 0.91, "{}", mean(&mri));
+    assert_eq!(pyvista.counts.lattice_scale, 1.0);
 }
 
-/// The lattice's second try is only a try: on grass it is finer (0.934) and makes 76 029
-/// quads; under a limit of 73 000 the run keeps the first mesh (70 757) instead of failing.
+/// The lattice's tries are only tries: on grass the kept one is finer (× 0.909) and makes
+/// 78 538 quads; under a limit of 73 000 the run keeps the first mesh (69 815) instead of
+/// failing.
 #[test]
 fn a_second_lattice_over_a_limit_keeps_the_first() {
     let run = |max_elements: u64| {
