@@ -32,6 +32,8 @@ struct Row {
     under_a_quarter: usize,
     shape_under_half: usize,
     jacobian_under_half: usize,
+    /// The share of the image's area whose label the mesh keeps (the report's).
+    label_agreement: f64,
     seconds: f64,
 }
 
@@ -42,6 +44,8 @@ struct Summary {
     seed: u64,
     mean_of_means: f64,
     mean_of_worst: f64,
+    /// The mean of the images' label agreements: what the clean-ups give away for quality.
+    mean_label_agreement: f64,
     quads: usize,
     under_a_quarter: usize,
     shape_under_half: usize,
@@ -89,6 +93,7 @@ pub fn run(
         seed,
         mean_of_means: rows.iter().map(|r| r.mean).sum::<f64>() / n,
         mean_of_worst: rows.iter().map(|r| r.worst).sum::<f64>() / n,
+        mean_label_agreement: rows.iter().map(|r| r.label_agreement).sum::<f64>() / n,
         quads: rows.iter().map(|r| r.quads).sum(),
         under_a_quarter: rows.iter().map(|r| r.under_a_quarter).sum(),
         shape_under_half: rows.iter().map(|r| r.shape_under_half).sum(),
@@ -154,6 +159,7 @@ fn measure(name: &str, image: GrayImage, options: &MeshOptions) -> Result<Row, S
             .iter()
             .filter(|q| scaled_jacobian(q) < 0.5 - 1e-9)
             .count(),
+        label_agreement: result.report.label_agreement,
         seconds,
     })
 }

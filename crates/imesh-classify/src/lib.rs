@@ -9,8 +9,9 @@
 //! - k-means colour clustering in CIE Lab (k-means++, fixed seed);
 //! - the supervised texture classifier of Imesh ([`TextureClassifier`]).
 //!
-//! Clean-up: [`remove_small_regions`], [`majority_filter`], and [`remove_border_slivers`] (the
-//! thin parts the majority filter leaves against the image's border).
+//! Clean-up: [`remove_small_regions`], [`majority_filter`], [`remove_border_slivers`] (the
+//! thin parts the majority filter leaves against the image's border) and [`remove_thin_parts`]
+//! (the parts of regions thinner than a width anywhere else: strips, necks, arms).
 //!
 //! ```
 //! use imesh_classify::{classify, Classifier, ClassifyOptions};
@@ -52,7 +53,7 @@ pub use kmeans::kmeans;
 pub use labels::{label_map, looks_like_label_map};
 pub use load::{decode_image, is_lossy_file, load_image, DEFAULT_MAX_PIXELS};
 pub use reduce::reduce;
-pub use slivers::{remove_border_slivers, MAX_SLIVER_HALF_WIDTH};
+pub use slivers::{remove_border_slivers, remove_thin_parts, MAX_SLIVER_HALF_WIDTH};
 pub use spec::Classifier;
 pub use texture::{SampleLabel, TextureClassifier, TextureSamples};
 pub use threshold::{luminance, multi_otsu_levels, threshold};

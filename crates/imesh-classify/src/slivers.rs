@@ -1,4 +1,6 @@
-//! Thin parts of regions pressed against the image's border.
+//! Thin parts of regions: pressed against the image's border ([`remove_border_slivers`]), and
+//! anywhere else ([`remove_thin_parts`]). Both are read off the morphological opening of each
+//! region by a disk: what no disk of one label covers is thin.
 //!
 //! The majority filter ([`crate::majority_filter`]) judges a pixel by the labels in its window,
 //! and at the image's border that window is cut off: a strip of one label between another
@@ -126,6 +128,138 @@ fn pinched_by_border(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
         }
     }
     pinched
+}
+
+/// Gives the parts of regions thinner than `2 · half_width` pixels (strips, necks, the arms
+/// between two wider parts of a region) to the regions beside them.
+///
+/// A pixel is *covered* when a disk of radius `half_width` holding it has one label over its
+/// pixels in the image (the morphological opening of its region, the image's outside free:
+/// thin parts against the border are [`remove_border_slivers`]'). Each 4-connected part of
+/// uncovered pixels of one label, of at least `min_pixels` pixels, is handed over from its rim
+/// inwards to the other labels it touches, and keeps its label if it touches none.
+///
+/// ```
+/// use imesh_classify::{remove_thin_parts, LabelGrid, Region};
+/// let r = |n: &str| Region { name: n.into(), colour: [0, 0, 0] };
+/// // Two 6 × 6 squares of label 1 joined by an arm one pixel wide, on label 0.
+/// let labels = (0..20 * 8)
+///     .map(|i| {
+///         let (x, y) = (i % 20, i / 20);
+///         u32::from((1..7).contains(&y) && ((1..7).contains(&x) || (13..19).contains(&x) || y == 3))
+///     })
+///     .collect();
+/// let g = LabelGrid::new(20, 8, labels, vec![r("a"), r("b")]).unwrap();
+/// let clean = remove_thin_parts(&g, 1.5, 4);
+/// // The arm goes to the background; the squares stay.
+/// assert!((8..12).all(|x| clean.label(x, 3) == 0));
+/// assert!(clean.label(3, 3) == 1 && clean.label(15, 3) == 1);
+/// ```
+pub fn remove_thin_parts(grid: &LabelGrid, half_width: f64, min_pixels: usize) -> LabelGrid {
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let labels = grid.labels();
+    if labels.is_empty() || half_width.is_nan() || half_width < 1.0 {
+        return grid.clone();
+    }
+    let r = half_width.min(MAX_SLIVER_HALF_WIDTH);
+    let mut removed = uncovered(labels, [w, h], r);
+    if !removed.contains(&true) {
+        return grid.clone();
+    }
+    keep_small_parts(&mut removed, labels, [w, h], min_pixels);
+    grid.with_labels(hand_over(labels, [w, h], &removed))
+}
+
+/// Per pixel: whether no disk of radius `r` centred on a pixel centre (in the image or up to
+/// `r` outside it) holds it with one label over the disk's pixels in the image.
+///
+/// A disk is a stack of row segments, so both steps go row by row: a centre's disk has one
+/// label when each of its rows lies within one run of that label, and a pixel is covered when
+/// some row of the disk around it holds such a centre close enough along that row. `O(r)` per
+/// pixel rather than the disk's `O(r²)`.
+fn uncovered(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
+    use rayon::prelude::*;
+    let reach = r.floor() as i64;
+    // The disk's half-length in each row `dy` from its centre, `-reach..=reach`.
+    let half: Vec<i64> = (-reach..=reach)
+        .map(|dy| {
+            let mut a = (r * r - (dy * dy) as f64).max(0.0).sqrt().floor() as i64;
+            // Integer check: the float root may land a hair under an exact square.
+            while (a + 1) * (a + 1) + dy * dy <= (r * r).floor() as i64 {
+                a += 1;
+            }
+            a
+        })
+        .collect();
+    let (wi, hi) = (w as i64, h as i64);
+    // Per pixel, the last column of its row's run of its label.
+    let run_end: Vec<u32> = labels
+        .par_chunks(w)
+        .flat_map_iter(|row| {
+            let mut end = vec![0u32; row.len()];
+            for x in (0..row.len()).rev() {
+                end[x] = if x + 1 < row.len() && row[x + 1] == row[x] {
+                    end[x + 1]
+                } else {
+                    x as u32
+                };
+            }
+            end
+        })
+        .collect();
+    // Per centre of the grid padded by `reach`: one label throughout its disk's pixels in the
+    // image (and at least one such pixel).
+    let padded_w = (w as i64 + 2 * reach) as usize;
+    let padded_h = (h as i64 + 2 * reach) as usize;
+    let one_label: Vec<bool> = (0..padded_w * padded_h)
+        .into_par_iter()
+        .map(|c| {
+            let (cx, cy) = ((c % padded_w) as i64 - reach, (c / padded_w) as i64 - reach);
+            let mut label = None;
+            for (dy, &a) in (-reach..=reach).zip(&half) {
+                let y = cy + dy;
+                let (x0, x1) = ((cx - a).max(0), (cx + a).min(wi - 1));
+                if y < 0 || y >= hi || x0 > x1 {
+                    continue;
+                }
+                let i = y as usize * w + x0 as usize;
+                if *label.get_or_insert(labels[i]) != labels[i] || i64::from(run_end[i]) < x1 {
+                    return false;
+                }
+            }
+            label.is_some()
+        })
+        .collect();
+    // Per padded centre: the first one-label centre at or after it in its row (`padded_w`
+    // for none).
+    let next_one: Vec<u32> = one_label
+        .par_chunks(padded_w)
+        .flat_map_iter(|row| {
+            let mut next = vec![padded_w as u32; row.len()];
+            for x in (0..row.len()).rev() {
+                next[x] = if row[x] {
+                    x as u32
+                } else if x + 1 < row.len() {
+                    next[x + 1]
+                } else {
+                    padded_w as u32
+                };
+            }
+            next
+        })
+        .collect();
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            // In padded coordinates.
+            let (x, y) = ((i % w) as i64 + reach, (i / w) as i64 + reach);
+            !(-reach..=reach).zip(&half).any(|(dy, &a)| {
+                let row = (y + dy) as usize * padded_w;
+                let from = (x - a) as usize;
+                i64::from(next_one[row + from]) <= x + a
+            })
+        })
+        .collect()
 }
 
 /// Clears the parts of `pinched` (4-connected, one label) smaller than `min_pixels`.
@@ -266,6 +400,18 @@ mod tests {
             }
         }
 
+        /// The uncovered pixels are those no disk of the opening's definition holds.
+        #[test]
+        fn the_uncovered_pixels_are_the_definitions((w, h, labels) in blobs(), r in 1.0f64..4.5) {
+            let thin = uncovered(&labels, [w, h], r);
+            for y in 0..h {
+                for x in 0..w {
+                    let (free, _) = covered(&labels, w, h, r, (x, y));
+                    prop_assert_eq!(thin[y * w + x], !free, "pixel ({}, {})", x, y);
+                }
+            }
+        }
+
         /// Only pinched pixels change, each to a label one of its 4-neighbours ends with and
         /// that is not its own, and no label is made.
         #[test]
@@ -285,6 +431,59 @@ mod tests {
                 }
             }
         }
+    }
+
+    proptest! {
+        /// Only uncovered pixels change, each to a label that one of its 4-neighbours ends
+        /// with and that is not its own; no label is made, and a covered pixel keeps its own.
+        #[test]
+        fn thin_parts_go_to_their_neighbours((w, h, labels) in blobs(), r in 1.0f64..3.5) {
+            let g = grid(w as u32, h as u32, labels.clone());
+            let clean = remove_thin_parts(&g, r, 2);
+            let thin = uncovered(&labels, [w, h], r);
+            let name = |grid: &LabelGrid, l: u32| grid.regions()[l as usize].name.clone();
+            let out: Vec<String> = clean.labels().iter().map(|&l| name(&clean, l)).collect();
+            for i in 0..w * h {
+                if out[i] != name(&g, labels[i]) {
+                    prop_assert!(thin[i]);
+                    prop_assert!(four_neighbours(i, w, h).into_iter().flatten().any(|j| out[j] == out[i]));
+                }
+            }
+        }
+    }
+
+    /// A strip two pixels wide across a region splits it: the strip goes to the region on both
+    /// sides, a strip three pixels wide stays at a radius of 1.5 px and goes at 2 px; a
+    /// notch shorter than `min_pixels` stays.
+    #[test]
+    fn a_thin_strip_goes_and_a_wider_one_stays() {
+        let strip = |width: usize| {
+            let (w, h) = (24usize, 16usize);
+            let labels = (0..w * h)
+                .map(|i| u32::from((10..10 + width).contains(&(i % w))))
+                .collect();
+            grid(w as u32, h as u32, labels)
+        };
+        let two = remove_thin_parts(&strip(2), 1.5, 4);
+        assert!((1..15).all(|y| (0..24).all(|x| two.label(x, y) == 0)));
+        let three = strip(3);
+        assert_eq!(remove_thin_parts(&three, 1.5, 4).labels(), three.labels());
+        // Disks reaching out of the image cover the strip's ends at the border (thin parts
+        // against the border are `remove_border_slivers`'); its inside goes.
+        let wider = remove_thin_parts(&three, 2.0, 4);
+        assert!((2..14).all(|y| (0..24).all(|x| wider.label(x, y) == 0)));
+        // A stub one pixel wide and three long on a wide region: under 4 pixels, it stays.
+        let (w, h) = (16usize, 16usize);
+        let labels: Vec<u32> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                u32::from(y >= 8 || (x == 7 && y >= 5))
+            })
+            .collect();
+        let stub = grid(w as u32, h as u32, labels.clone());
+        assert_eq!(remove_thin_parts(&stub, 1.5, 4).labels(), &labels[..]);
+        let gone = remove_thin_parts(&stub, 1.5, 3);
+        assert!((5..8).all(|y| gone.label(7, y) == 0));
     }
 
     /// A disc whose edge comes within two pixels of the image's left side: the tapering gap

@@ -184,6 +184,29 @@ pub const AUTO_MIN_WIDTH: f64 = 0.5;
 /// coarsened coffee's quads (2.0 → 2.9 px, mean 0.912 → 0.908).
 pub const THIN_REGION_SHARE: f64 = 0.75;
 
+/// The automatic [`MeshOptions::min_part_width`], as a share of the quad side: the parts of
+/// regions thinner than a quad (strips, necks, arms between wider parts, of at least
+/// [`THIN_PART_AREA`]) go to the regions beside them after the majority filter. The filter
+/// thins such strips without removing them (camera's tripod: a strip 2–3 px wide between two
+/// legs at quads of 5 px), and [`THIN_REGION_SHARE`] merges only whole regions; the templates
+/// fill a strip `d` wide with two rows of quads of about `1.3 (d / q)²` of the mean area,
+/// under 0.25 in shape-and-size (whose size term is squared) below about two thirds of a quad.
+/// A part is what no disk of half this width, one label throughout, covers
+/// ([`imesh_classify::remove_thin_parts`]); the disks are centred on pixel centres, so under
+/// 2 px (quads under 2 px) nothing goes. Measured with the defaults (`cargo xtask bench
+/// random`, seven sets of 150 images; docs/measurements.md, session 58): the mean of the means
+/// up on all seven (+0.0002 to +0.0046), quads under 0.25 down by 21–44 %, under 0.5 in shape
+/// 158 → 63 and in scaled Jacobian 23 → 12, label agreement 0.02–0.12 points lower. At 1.5
+/// quad sides the means rose further (+0.0007 to +0.0076) but at `--size 3` the label
+/// agreement fell by 0.6–0.7 points; at 2, by 0.5 points with the defaults.
+pub const THIN_PART_SHARE: f64 = 1.0;
+
+/// The least area, in quad areas, of a thin part [`THIN_PART_SHARE`] gives away: a smaller
+/// one (a tip, a notch, a square corner's rounding) holds a few small quads at most, and the
+/// tip cuts and the curve tolerance deal with it. A quarter of a quad changed twice as many
+/// meshes for about the same means; three quads lowered them.
+pub const THIN_PART_AREA: f64 = 1.0;
+
 /// After the majority filter, the parts of regions thinner than twice this share of its radius
 /// (the radius is about a quad side: half a quad) only because they lie
 /// against the image's border, each of at least a quad's area, are given to their neighbours
@@ -389,6 +412,12 @@ pub struct MeshOptions {
     /// quad path: `None` (auto) is [`THIN_REGION_SHARE`] of the finest quad side a uniform mesh
     /// can end with and nothing for a graded one; 0 keeps every region.
     pub min_width: Option<f64>,
+    /// Parts of regions thinner than this many pixels (strips, necks, the arms between wider
+    /// parts of a region), each of at least [`THIN_PART_AREA`] quad areas, are given to the
+    /// regions beside them before meshing ([`imesh_classify::remove_thin_parts`], after the
+    /// majority filter): `None` (auto) is [`THIN_PART_SHARE`] of the quad side for a uniform
+    /// quad mesh and nothing for a graded one or triangles; 0 keeps every part.
+    pub min_part_width: Option<f64>,
     /// Regions (4-connected) smaller than this many pixels are merged into the neighbour they
     /// share the longest border with before meshing (0: every region is kept).
     pub min_region: usize,
@@ -402,8 +431,8 @@ pub struct MeshOptions {
     /// `F × F` pixels ([`imesh_classify::reduce`]), then scale the mesh back onto the image:
     /// `None` (auto) reduces a uniform quad mesh whose quads (of automatic size, or of the size
     /// given) would be at least twice [`AUTO_REDUCTION_SIZE`] pixels wide, `Some(1)` never.
-    /// The options given in pixels (size, tolerance, majority, min-width, min-region, max-size)
-    /// are converted to cells; the defaults apply to the cells as to pixels (the curve
+    /// The options given in pixels (size, tolerance, majority, min-width, min-part-width,
+    /// min-region, max-size) are converted to cells; the defaults apply to the cells as to pixels (the curve
     /// tolerance is then 2 cells).
     pub reduction: Option<u32>,
     /// Curve simplification tolerance in pixels (quads); `None`:
@@ -458,6 +487,7 @@ impl Default for MeshOptions {
             max_size: None,
             size: ElementSize::Auto,
             min_width: None,
+            min_part_width: None,
             min_region: 0,
             majority: None,
             reduction: None,
@@ -1176,7 +1206,10 @@ impl Pipeline {
             .majority
             .unwrap_or_else(|| quad_size.map_or(0, auto_majority));
         let original = grid;
-        let cleaned = self.clean_up(grid, majority);
+        let min_width = o
+            .min_width
+            .unwrap_or_else(|| quad_size.map_or(0.0, |q| self.auto_min_width(q)));
+        let cleaned = self.clean_up(grid, majority, quad_size);
         let (grid, cleaned_pixels) = match &cleaned {
             Some((g, changed)) => (g, *changed),
             None => (grid, 0),
@@ -1190,9 +1223,6 @@ impl Pipeline {
             },
         )?;
         let mut label = partition(grid, &sampling.triangulation);
-        let min_width = o
-            .min_width
-            .unwrap_or_else(|| quad_size.map_or(0.0, |q| self.auto_min_width(q)));
         let (w, h) = (grid.width(), grid.height());
         let mut merged = match o.elements {
             Elements::Quad => merge_thin_regions(&sampling.triangulation, &mut label, min_width),
@@ -1779,13 +1809,24 @@ impl Pipeline {
         Ok((vertices, elements, r.mesh.labels, curved))
     }
 
-    /// The refinement's point cap: the user's, and never more than the element limit (every
-    /// inserted point adds about two triangles).
-    /// The label grid after the clean-up the options ask for (a majority filter, then merging
-    /// small regions), with the number of pixels whose label changed; `None` without clean-up.
-    fn clean_up(&self, grid: &LabelGrid, majority: u32) -> Option<(LabelGrid, usize)> {
+    /// The label grid after the clean-up the options ask for (a majority filter, the border's
+    /// thin parts, for quads of side `quad_size` the thin parts of
+    /// [`MeshOptions::min_part_width`], then merging small regions), with the number of pixels
+    /// whose label changed; `None` without clean-up.
+    fn clean_up(
+        &self,
+        grid: &LabelGrid,
+        majority: u32,
+        quad_size: Option<f64>,
+    ) -> Option<(LabelGrid, usize)> {
         let o = &self.options;
-        if majority == 0 && o.min_region <= 1 {
+        let thin_parts = quad_size.map(|q| {
+            let width = o.min_part_width.unwrap_or(THIN_PART_SHARE * q);
+            (width, (THIN_PART_AREA * q * q).round() as usize)
+        });
+        // A disk of radius under a pixel is its pixel alone: every part is covered.
+        let thin_parts = thin_parts.filter(|&(width, _)| width >= 2.0);
+        if majority == 0 && o.min_region <= 1 && thin_parts.is_none() {
             return None;
         }
         let mut cleaned = grid.clone();
@@ -1802,6 +1843,9 @@ impl Pipeline {
                 half_width,
                 (majority * majority) as usize,
             );
+        }
+        if let Some((width, least)) = thin_parts {
+            cleaned = imesh_classify::remove_thin_parts(&cleaned, width / 2.0, least);
         }
         if o.min_region > 1 {
             cleaned = imesh_classify::remove_small_regions(&cleaned, o.min_region);
@@ -1843,6 +1887,8 @@ impl Pipeline {
         THIN_REGION_SHARE * finest
     }
 
+    /// The refinement's point cap: the user's, and never more than the element limit (every
+    /// inserted point adds about two triangles).
     fn refinement_cap(&self) -> usize {
         let o = &self.options;
         let limit = usize::try_from(o.max_elements).unwrap_or(usize::MAX);
@@ -1911,6 +1957,12 @@ impl Pipeline {
                  region), not {w}"
             )));
         }
+        if let Some(w) = o.min_part_width.filter(|w| !(w.is_finite() && *w >= 0.0)) {
+            return Err(PipelineError::Options(format!(
+                "the smallest part width must be a distance in pixels ≥ 0 (0 keeps every part), \
+                 not {w}"
+            )));
+        }
         if let Some(t) = o.tolerance.filter(|t| !(t.is_finite() && *t >= 0.0)) {
             return Err(PipelineError::Options(format!(
                 "the curve tolerance must be a distance in pixels ≥ 0, not {t}"
@@ -1956,6 +2008,7 @@ impl MeshOptions {
             tolerance: self.tolerance.map(|t| t / s),
             majority: self.majority.map(|r| (f64::from(r) / s).round() as u32),
             min_width: self.min_width.map(|w| w / s),
+            min_part_width: self.min_part_width.map(|w| w / s),
             min_region: (self.min_region as f64 / (sx * sy)).ceil() as usize,
             max_size: self.max_size.map(|m| m / s),
             ..self.clone()
@@ -2581,7 +2634,10 @@ mod tests {
         let grid = classify(&image, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
         let pipeline = Pipeline::new(MeshOptions::default());
         let q = pipeline.quad_size(&grid).unwrap();
-        let (grid, _) = pipeline.clean_up(&grid, auto_majority(q)).unwrap();
+        // The majority filter as the pipeline has it, but no thin parts given away (the
+        // pipeline's last clean-up): the flattened regions and necks these tests need are
+        // such parts.
+        let (grid, _) = pipeline.clean_up(&grid, auto_majority(q), None).unwrap();
         let sampling = sample(&grid, &SampleOptions::default()).unwrap();
         let min_width = pipeline.auto_min_width(q);
         let mut label = partition(&grid, &sampling.triangulation);

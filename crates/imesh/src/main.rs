@@ -148,6 +148,11 @@ struct MeshFlags {
     /// finest quad side for uniform quads (1.5 px at the 2 px floor), none otherwise].
     #[arg(long)]
     min_width: Option<AutoOr<f64>>,
+    /// Give the parts of regions thinner than this many pixels (strips, necks, arms between
+    /// wider parts) to the regions beside them before meshing; 0 keeps every part [default:
+    /// auto, one quad side for uniform quads, none otherwise].
+    #[arg(long)]
+    min_part_width: Option<AutoOr<f64>>,
     /// Keep the regions' tips sharper than 30° as the image has them (the quad there keeps a
     /// corner that sharp) instead of cutting them off where they are a quad side or two wide
     /// (uniform quads; the report's counts.blunted_tips and blunted_area_px).
@@ -321,6 +326,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if let Some(w) = args.min_width {
         o.min_width = w.value();
+    }
+    if let Some(w) = args.min_part_width {
+        o.min_part_width = w.value();
     }
     if let Some(f) = args.reduction {
         o.reduction = f.value();
@@ -762,9 +770,10 @@ fn clean_up_notes(c: &imesh::Counts, fidelity: &imesh::Fidelity) -> Vec<String> 
         "the mesh".to_string()
     };
     let keep = if c.reduction > 1 {
-        "a smaller --size, --reduction 1, or --majority 0 --min-width 0, keeps more of them"
+        "a smaller --size, --reduction 1, or --majority 0 --min-width 0 --min-part-width 0, keeps \
+         more of them"
     } else {
-        "a smaller --size, or --majority 0 --min-width 0, keeps more of them"
+        "a smaller --size, or --majority 0 --min-width 0 --min-part-width 0, keeps more of them"
     };
     let mut notes = Vec::new();
     if c.meshed_labels < c.image_labels {

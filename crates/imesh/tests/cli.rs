@@ -456,6 +456,10 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
             "neither auto nor a number",
         ),
         (&["mesh", image, "--min-width=-2"], "smallest region width"),
+        (
+            &["mesh", image, "--min-part-width=-2"],
+            "smallest part width",
+        ),
         (&["mesh", image, "--reduction", "0"], "a reduction of 0"),
         (&["mesh", image, "--origin", "5"], "give X,Y"),
         (&["mesh", image, "--msh-version", "3"], "4.1"),
@@ -918,8 +922,9 @@ fn the_svg_can_be_drawn_over_the_input_image() {
 }
 
 /// The note on a forced worst corner appears only for a corner sharper than 30°: MRI's spike tip
-/// (27.0°) when its sharp tips are kept, not a square region's right angles. By default the
-/// tip is cut off, and the command says so.
+/// (27.0°) when its sharp tips and thin parts are kept, not a square region's right angles. By
+/// default the spike, thinner than a quad, goes with the thin parts; with them kept, the tip
+/// is cut off, and the command says so.
 #[test]
 fn the_forced_corner_note_names_only_sharp_corners() {
     let dir = tempfile::tempdir().unwrap();
@@ -927,7 +932,15 @@ fn the_forced_corner_note_names_only_sharp_corners() {
     let mri = fixture("matplotlib-s1045_mri.png");
     let mri = mri.to_str().unwrap();
     let out = imesh(
-        &["mesh", mri, "-o", "mri.msh", "--keep-sharp-tips"],
+        &[
+            "mesh",
+            mri,
+            "-o",
+            "mri.msh",
+            "--keep-sharp-tips",
+            "--min-part-width",
+            "0",
+        ],
         dir.path(),
     );
     let said = String::from_utf8_lossy(&out.stdout);
@@ -935,10 +948,19 @@ fn the_forced_corner_note_names_only_sharp_corners() {
         said.contains(&format!("a corner of 27.0° {note}")) && !said.contains("cut off"),
         "{said}"
     );
-    let out = imesh(&["mesh", mri, "-o", "mri.msh"], dir.path());
+    let out = imesh(
+        &["mesh", mri, "-o", "mri.msh", "--min-part-width", "0"],
+        dir.path(),
+    );
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success() && !said.contains(note) && said.contains("cut off 3 region tips"),
+        "{said}"
+    );
+    let out = imesh(&["mesh", mri, "-o", "mri.msh"], dir.path());
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && !said.contains(note) && !said.contains("cut off"),
         "{said}"
     );
     // A square of one label in another: the image's corners and the square's are right angles,
@@ -983,7 +1005,10 @@ fn the_command_says_when_the_clean_up_drops_a_label() {
         said.contains(dropped) && said.contains(relabelled),
         "{said}"
     );
-    assert!(said.contains("--majority 0 --min-width 0"), "{said}");
+    assert!(
+        said.contains("--majority 0 --min-width 0 --min-part-width 0"),
+        "{said}"
+    );
     let report: serde_json::Value = read_report(dir.path());
     assert_eq!(report["counts"]["image_labels"], 2);
     assert_eq!(report["counts"]["meshed_labels"], 1);
@@ -996,6 +1021,8 @@ fn the_command_says_when_the_clean_up_drops_a_label() {
             "--majority",
             "0",
             "--min-width",
+            "0",
+            "--min-part-width",
             "0",
         ],
         dir.path(),

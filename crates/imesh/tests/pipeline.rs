@@ -205,9 +205,10 @@ fn every_fixture_gives_a_valid_quad_mesh_and_a_valid_triangle_mesh() {
         }
         if path.ends_with("opencv-aloeGT.png") {
             // Its pixel spikes and staircases: 234 tips cut (180 before they could be cut from
-            // a short side's end; none at all if one bad cut dropped every cut).
+            // a short side's end; none at all if one bad cut dropped every cut), 197 since
+            // session 58's thin parts took the thinnest spikes first.
             assert!(
-                r.counts.blunted_tips > 200,
+                r.counts.blunted_tips > 170,
                 "aloe: {} tips",
                 r.counts.blunted_tips
             );
@@ -262,6 +263,7 @@ fn a_uniform_size_gives_higher_shape_and_size_than_a_graded_one() {
         size: ElementSize::Pixels(3.0),
         majority: Some(0),
         min_width: Some(0.0),
+        min_part_width: Some(0.0),
         ..Default::default()
     };
     let uniform = run(bare.clone());
@@ -376,13 +378,15 @@ fn the_lattice_is_scaled_to_the_mean_quad() {
     // within 1 %), 0.9052.
     assert!((0.93..=0.97).contains(&camera.counts.lattice_scale));
     assert!(mean(&camera) >= 0.92, "{}", mean(&camera));
-    assert!((0.93..=0.99).contains(&mri.counts.lattice_scale));
+    // MRI × 0.93–0.99 in session 57; since session 58's thin parts its median is within
+    // 0.2 % of the mean at the first lattice (× 1, 0.9151).
+    assert!((0.93..=1.0).contains(&mri.counts.lattice_scale));
     assert!(mean(&mri) >= 0.91, "{}", mean(&mri));
     assert_eq!(pyvista.counts.lattice_scale, 1.0);
 }
 
 /// The lattice's tries are only tries: on grass the kept one is finer (× 0.909) and makes
-/// 78 538 quads; under a limit of 73 000 the run keeps the first mesh (69 815) instead of
+/// 78 095 quads; under a limit of 73 000 the run keeps the first mesh (69 218) instead of
 /// failing.
 #[test]
 fn a_second_lattice_over_a_limit_keeps_the_first() {
@@ -589,6 +593,52 @@ fn a_strip_a_pixel_wide_along_the_border_goes_to_its_neighbour() {
     );
 }
 
+/// Two discs joined by an arm 3 px wide, meshed with quads of 6 px (no majority filter, which
+/// would thin the arm but here is off to show the rule alone): the arm is a part of the
+/// region thinner than a quad, whose quads can only be a fraction of the mean area. Given to
+/// the background (`min_part_width`, automatic: one quad side), the discs are meshed apart;
+/// kept, the arm's quads score far under the paper's 0.25.
+#[test]
+fn a_thin_arm_between_two_wide_parts_goes_to_its_neighbour() {
+    let image = support::grey(240, 120, |x, y| {
+        let disc = |cx: f64| (f64::from(x) - cx).powi(2) + (f64::from(y) - 60.0).powi(2) < 900.0;
+        if disc(60.0) || disc(180.0) || ((80..160).contains(&x) && (59..62).contains(&y)) {
+            255
+        } else {
+            0
+        }
+    });
+    let run = |min_part_width: Option<f64>| {
+        let options = MeshOptions {
+            size: ElementSize::Pixels(6.0),
+            majority: Some(0),
+            min_part_width,
+            ..Default::default()
+        };
+        Pipeline::new(options).run_image(&image).unwrap().report
+    };
+    let given = run(None);
+    let kept = run(Some(0.0));
+    fn ss(r: &imesh::Report) -> &imesh_quality::Statistics {
+        r.quality.shape_and_size().expect("quads")
+    }
+    eprintln!(
+        "arm given away: worst {:.3}, mean {:.3}, {} px changed; kept: worst {:.3}, mean {:.3}",
+        ss(&given).min,
+        ss(&given).mean,
+        given.counts.cleaned_pixels,
+        ss(&kept).min,
+        ss(&kept).mean
+    );
+    assert!(given.validation.valid && kept.validation.valid);
+    // The arm between the discs (3 × 60 pixels outside them), and nothing else.
+    assert!((170..=200).contains(&given.counts.cleaned_pixels));
+    assert_eq!(kept.counts.cleaned_pixels, 0);
+    assert!(ss(&kept).min < 0.1);
+    assert!(ss(&given).min > 0.25);
+    assert!(ss(&given).mean > ss(&kept).mean);
+}
+
 /// Under a reduction the options given in pixels are converted to cells, the defaults apply to
 /// the cells: a 2 px tolerance keeps the boundaries within 2 px of the image's, the default
 /// within 2 cells. (Graded: no quad-sized joining of short pieces, so the tolerance is the
@@ -647,13 +697,16 @@ fn the_mesh_and_the_report_are_the_same_on_one_and_two_threads() {
 
 /// The MRI's spike tips (27° between the curves, which turning within the tolerance could not
 /// open) are cut off where they are a quad side or two wide: the worst scaled Jacobian reaches
-/// 0.5 instead of the tips' sine, for a few pixels given to the neighbour region.
+/// 0.5 instead of the tips' sine, for a few pixels given to the neighbour region. (With the
+/// defaults the spikes, thinner than a quad, go with the thin parts first; here those are
+/// kept.)
 #[test]
 fn sharp_tips_are_cut_unless_kept() {
     let path = support::fixture("matplotlib-s1045_mri.png");
     let run = |keep_sharp_tips: bool| {
         Pipeline::new(MeshOptions {
             keep_sharp_tips,
+            min_part_width: Some(0.0),
             ..MeshOptions::default()
         })
         .run_path(&path)
