@@ -176,7 +176,8 @@ pub fn remove_thin_parts(grid: &LabelGrid, half_width: f64, min_pixels: usize) -
 /// A disk is a stack of row segments, so both steps go row by row: a centre's disk has one
 /// label when each of its rows lies within one run of that label, and a pixel is covered when
 /// some row of the disk around it holds such a centre close enough along that row. `O(r)` per
-/// pixel rather than the disk's `O(r²)`.
+/// pixel rather than the disk's `O(r²)`, and a centre far from every label change
+/// ([`far_from_edges`]) is one label without a look at its rows.
 fn uncovered(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
     use rayon::prelude::*;
     let reach = r.floor() as i64;
@@ -211,10 +212,14 @@ fn uncovered(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
     // image (and at least one such pixel).
     let padded_w = (w as i64 + 2 * reach) as usize;
     let padded_h = (h as i64 + 2 * reach) as usize;
+    let far = far_from_edges(labels, [w, h], reach as u32);
     let one_label: Vec<bool> = (0..padded_w * padded_h)
         .into_par_iter()
         .map(|c| {
             let (cx, cy) = ((c % padded_w) as i64 - reach, (c / padded_w) as i64 - reach);
+            if cx >= 0 && cy >= 0 && cx < wi && cy < hi && far[cy as usize * w + cx as usize] {
+                return true;
+            }
             let mut label = None;
             for (dy, &a) in (-reach..=reach).zip(&half) {
                 let y = cy + dy;
@@ -260,6 +265,75 @@ fn uncovered(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
             })
         })
         .collect()
+}
+
+/// Per pixel: whether no *edge* pixel (one with a 4-neighbour of another label) lies within
+/// `reach` of it in both coordinates. The square of side `2 reach + 1` around such a pixel has
+/// one label over its pixels in the image (two labels in it would put two 4-adjacent pixels of
+/// different labels, both edge pixels, in it), and so has its disk of radius under
+/// `reach + 1`: most centres far inside their regions are settled without looking at their
+/// disk. The chessboard distance to the edges, by the two sequential passes of a chamfer
+/// transform (capped at `reach + 1`).
+fn far_from_edges(labels: &[u32], [w, h]: [usize; 2], reach: u32) -> Vec<bool> {
+    use rayon::prelude::*;
+    let cap = reach + 1;
+    let mut d: Vec<u32> = (0..labels.len())
+        .into_par_iter()
+        .map(|i| {
+            let edge = four_neighbours(i, w, h)
+                .into_iter()
+                .flatten()
+                .any(|j| labels[j] != labels[i]);
+            if edge {
+                0
+            } else {
+                cap
+            }
+        })
+        .collect();
+    // Forward: the neighbours before a pixel in reading order (left, and the three above).
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let mut best = d[i];
+            if x > 0 {
+                best = best.min(d[i - 1] + 1);
+            }
+            if y > 0 {
+                let up = i - w;
+                best = best.min(d[up] + 1);
+                if x > 0 {
+                    best = best.min(d[up - 1] + 1);
+                }
+                if x + 1 < w {
+                    best = best.min(d[up + 1] + 1);
+                }
+            }
+            d[i] = best.min(cap);
+        }
+    }
+    // Backward: right, and the three below.
+    for y in (0..h).rev() {
+        for x in (0..w).rev() {
+            let i = y * w + x;
+            let mut best = d[i];
+            if x + 1 < w {
+                best = best.min(d[i + 1] + 1);
+            }
+            if y + 1 < h {
+                let down = i + w;
+                best = best.min(d[down] + 1);
+                if x + 1 < w {
+                    best = best.min(d[down + 1] + 1);
+                }
+                if x > 0 {
+                    best = best.min(d[down - 1] + 1);
+                }
+            }
+            d[i] = best.min(cap);
+        }
+    }
+    d.into_par_iter().map(|d| d > reach).collect()
 }
 
 /// Clears the parts of `pinched` (4-connected, one label) smaller than `min_pixels`.
@@ -408,6 +482,23 @@ mod tests {
                 for x in 0..w {
                     let (free, _) = covered(&labels, w, h, r, (x, y));
                     prop_assert_eq!(thin[y * w + x], !free, "pixel ({}, {})", x, y);
+                }
+            }
+        }
+
+        /// The chamfer passes give the chessboard distance to the edge pixels: a pixel is far
+        /// exactly when no edge pixel lies within `reach` in both coordinates.
+        #[test]
+        fn far_pixels_are_the_definitions((w, h, labels) in blobs(), reach in 0u32..5) {
+            let far = far_from_edges(&labels, [w, h], reach);
+            let edge = |i: usize| four_neighbours(i, w, h).into_iter().flatten().any(|j| labels[j] != labels[i]);
+            for y in 0..h {
+                for x in 0..w {
+                    let r = reach as usize;
+                    let near = (y.saturating_sub(r)..=(y + r).min(h - 1)).any(|yy| {
+                        (x.saturating_sub(r)..=(x + r).min(w - 1)).any(|xx| edge(yy * w + xx))
+                    });
+                    prop_assert_eq!(far[y * w + x], !near, "pixel ({}, {})", x, y);
                 }
             }
         }
