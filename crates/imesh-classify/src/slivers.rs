@@ -43,14 +43,25 @@ use crate::LabelGrid;
 /// assert_eq!(remove_border_slivers(&g, 1.5, 9).labels(), g.labels());
 /// ```
 pub fn remove_border_slivers(grid: &LabelGrid, half_width: f64, min_pixels: usize) -> LabelGrid {
+    give_away(grid, half_width, min_pixels, pinched_by_border)
+}
+
+/// `grid` with the pixels that `thin` finds at disks of radius `half_width` (at most
+/// [`MAX_SLIVER_HALF_WIDTH`]) given to the labels beside them, part by part ([`hand_over`]),
+/// parts under `min_pixels` kept.
+fn give_away(
+    grid: &LabelGrid,
+    half_width: f64,
+    min_pixels: usize,
+    thin: fn(&[u32], [usize; 2], f64) -> Vec<bool>,
+) -> LabelGrid {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
     let labels = grid.labels();
-    // Under a pixel every disk is its pixel alone: nothing is pinched.
+    // Under a pixel every disk is its pixel alone: nothing is thin.
     if labels.is_empty() || half_width.is_nan() || half_width < 1.0 {
         return grid.clone();
     }
-    let half_width = half_width.min(MAX_SLIVER_HALF_WIDTH);
-    let mut removed = pinched_by_border(labels, [w, h], half_width);
+    let mut removed = thin(labels, [w, h], half_width.min(MAX_SLIVER_HALF_WIDTH));
     if !removed.contains(&true) {
         return grid.clone();
     }
@@ -58,8 +69,9 @@ pub fn remove_border_slivers(grid: &LabelGrid, half_width: f64, min_pixels: usiz
     grid.with_labels(hand_over(labels, [w, h], &removed))
 }
 
-/// The largest `half_width` [`remove_border_slivers`] uses (a larger one is taken as this): its
-/// work along the border grows as the cube of the half-width.
+/// The largest `half_width` [`remove_border_slivers`] and [`remove_thin_parts`] use (a larger
+/// one is taken as this): the first's work along the border grows as the cube of the
+/// half-width, the second's near the label changes as the square.
 pub const MAX_SLIVER_HALF_WIDTH: f64 = 16.0;
 
 /// Per pixel: whether it is covered by a disk of radius `r` of one label when the outside may
@@ -156,18 +168,7 @@ fn pinched_by_border(labels: &[u32], [w, h]: [usize; 2], r: f64) -> Vec<bool> {
 /// assert!(clean.label(3, 3) == 1 && clean.label(15, 3) == 1);
 /// ```
 pub fn remove_thin_parts(grid: &LabelGrid, half_width: f64, min_pixels: usize) -> LabelGrid {
-    let (w, h) = (grid.width() as usize, grid.height() as usize);
-    let labels = grid.labels();
-    if labels.is_empty() || half_width.is_nan() || half_width < 1.0 {
-        return grid.clone();
-    }
-    let r = half_width.min(MAX_SLIVER_HALF_WIDTH);
-    let mut removed = uncovered(labels, [w, h], r);
-    if !removed.contains(&true) {
-        return grid.clone();
-    }
-    keep_small_parts(&mut removed, labels, [w, h], min_pixels);
-    grid.with_labels(hand_over(labels, [w, h], &removed))
+    give_away(grid, half_width, min_pixels, uncovered)
 }
 
 /// Per pixel: whether no disk of radius `r` centred on a pixel centre (in the image or up to
@@ -462,25 +463,20 @@ mod tests {
 
     proptest! {
         /// The pinched pixels are those the opening's definition gives, though only a band
-        /// `2r` wide along the border is looked at.
+        /// `2r` wide along the border is looked at; the uncovered pixels are those no disk of
+        /// the definition holds, though they are found row by row and most centres without a
+        /// look at their disk.
         #[test]
-        fn the_pinched_pixels_are_the_definitions((w, h, labels) in blobs(), r in 1.0f64..3.5) {
+        fn the_pinched_and_uncovered_pixels_are_the_definitions(
+            (w, h, labels) in blobs(),
+            r in 1.0f64..4.5,
+        ) {
             let pinched = pinched_by_border(&labels, [w, h], r);
+            let thin = uncovered(&labels, [w, h], r);
             for y in 0..h {
                 for x in 0..w {
                     let (free, inside) = covered(&labels, w, h, r, (x, y));
                     prop_assert_eq!(pinched[y * w + x], free && !inside, "pixel ({}, {})", x, y);
-                }
-            }
-        }
-
-        /// The uncovered pixels are those no disk of the opening's definition holds.
-        #[test]
-        fn the_uncovered_pixels_are_the_definitions((w, h, labels) in blobs(), r in 1.0f64..4.5) {
-            let thin = uncovered(&labels, [w, h], r);
-            for y in 0..h {
-                for x in 0..w {
-                    let (free, _) = covered(&labels, w, h, r, (x, y));
                     prop_assert_eq!(thin[y * w + x], !free, "pixel ({}, {})", x, y);
                 }
             }
@@ -504,22 +500,14 @@ mod tests {
         }
 
         /// Only pinched pixels change, each to a label one of its 4-neighbours ends with and
-        /// that is not its own, and no label is made.
+        /// that is not its own, and no label is made; they lie in the band along the border.
         #[test]
         fn slivers_go_to_their_neighbours((w, h, labels) in blobs(), r in 1.0f64..3.5) {
             let g = grid(w as u32, h as u32, labels.clone());
-            let clean = remove_border_slivers(&g, r, 2);
-            let pinched = pinched_by_border(&labels, [w, h], r);
-            let name = |grid: &LabelGrid, l: u32| grid.regions()[l as usize].name.clone();
-            let out: Vec<String> = clean.labels().iter().map(|&l| name(&clean, l)).collect();
-            for i in 0..w * h {
-                let before = name(&g, labels[i]);
-                if out[i] != before {
-                    prop_assert!(pinched[i]);
-                    let (x, y) = (i % w, i / w);
-                    prop_assert!(x.min(w - 1 - x).min(y).min(h - 1 - y) < (2.0 * r).ceil() as usize);
-                    prop_assert!(four_neighbours(i, w, h).into_iter().flatten().any(|j| out[j] == out[i]));
-                }
+            let changed = changed_where_thin(&g, &remove_border_slivers(&g, r, 2), &pinched_by_border(&labels, [w, h], r))?;
+            for i in changed {
+                let (x, y) = (i % w, i / w);
+                prop_assert!(x.min(w - 1 - x).min(y).min(h - 1 - y) < (2.0 * r).ceil() as usize);
             }
         }
     }
@@ -530,17 +518,32 @@ mod tests {
         #[test]
         fn thin_parts_go_to_their_neighbours((w, h, labels) in blobs(), r in 1.0f64..3.5) {
             let g = grid(w as u32, h as u32, labels.clone());
-            let clean = remove_thin_parts(&g, r, 2);
-            let thin = uncovered(&labels, [w, h], r);
-            let name = |grid: &LabelGrid, l: u32| grid.regions()[l as usize].name.clone();
-            let out: Vec<String> = clean.labels().iter().map(|&l| name(&clean, l)).collect();
-            for i in 0..w * h {
-                if out[i] != name(&g, labels[i]) {
-                    prop_assert!(thin[i]);
-                    prop_assert!(four_neighbours(i, w, h).into_iter().flatten().any(|j| out[j] == out[i]));
-                }
+            changed_where_thin(&g, &remove_thin_parts(&g, r, 2), &uncovered(&labels, [w, h], r))?;
+        }
+    }
+
+    /// The pixels whose region `clean` changed from `g`'s, after checking that each is `thin`
+    /// and has a 4-neighbour of its new region (regions compared by name: no label is made).
+    fn changed_where_thin(
+        g: &LabelGrid,
+        clean: &LabelGrid,
+        thin: &[bool],
+    ) -> Result<Vec<usize>, TestCaseError> {
+        let (w, h) = (g.width() as usize, g.height() as usize);
+        let name = |grid: &LabelGrid, l: u32| grid.regions()[l as usize].name.clone();
+        let out: Vec<String> = clean.labels().iter().map(|&l| name(clean, l)).collect();
+        let mut changed = Vec::new();
+        for i in 0..w * h {
+            if out[i] != name(g, g.labels()[i]) {
+                prop_assert!(thin[i]);
+                prop_assert!(four_neighbours(i, w, h)
+                    .into_iter()
+                    .flatten()
+                    .any(|j| out[j] == out[i]));
+                changed.push(i);
             }
         }
+        Ok(changed)
     }
 
     /// A strip two pixels wide across a region splits it: the strip goes to the region on both
