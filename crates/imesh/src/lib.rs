@@ -432,8 +432,8 @@ pub struct MeshOptions {
     /// `None` (auto) reduces a uniform quad mesh whose quads (of automatic size, or of the size
     /// given) would be at least twice [`AUTO_REDUCTION_SIZE`] pixels wide, `Some(1)` never.
     /// The options given in pixels (size, tolerance, majority, min-width, min-part-width,
-    /// min-region, max-size) are converted to cells; the defaults apply to the cells as to pixels (the curve
-    /// tolerance is then 2 cells).
+    /// min-region, max-size) are converted to cells; the defaults apply to the cells as to
+    /// pixels (the curve tolerance is then 2 cells).
     pub reduction: Option<u32>,
     /// Curve simplification tolerance in pixels (quads); `None`:
     /// [`imesh_curves::DEFAULT_TOLERANCE`] pixels, or that many cells of a reduced grid.
@@ -1206,9 +1206,6 @@ impl Pipeline {
             .majority
             .unwrap_or_else(|| quad_size.map_or(0, auto_majority));
         let original = grid;
-        let min_width = o
-            .min_width
-            .unwrap_or_else(|| quad_size.map_or(0.0, |q| self.auto_min_width(q)));
         let cleaned = self.clean_up(grid, majority, quad_size);
         let (grid, cleaned_pixels) = match &cleaned {
             Some((g, changed)) => (g, *changed),
@@ -1223,6 +1220,9 @@ impl Pipeline {
             },
         )?;
         let mut label = partition(grid, &sampling.triangulation);
+        let min_width = o
+            .min_width
+            .unwrap_or_else(|| quad_size.map_or(0.0, |q| self.auto_min_width(q)));
         let (w, h) = (grid.width(), grid.height());
         let mut merged = match o.elements {
             Elements::Quad => merge_thin_regions(&sampling.triangulation, &mut label, min_width),
@@ -2634,9 +2634,8 @@ mod tests {
         let grid = classify(&image, &Classifier::Auto, &ClassifyOptions::default()).unwrap();
         let pipeline = Pipeline::new(MeshOptions::default());
         let q = pipeline.quad_size(&grid).unwrap();
-        // The majority filter as the pipeline has it, but no thin parts given away (the
-        // pipeline's last clean-up): the flattened regions and necks these tests need are
-        // such parts.
+        // The majority filter as the pipeline has it, but the thin parts it gives away after
+        // the filter kept: the flattened regions and necks these tests need are such parts.
         let (grid, _) = pipeline.clean_up(&grid, auto_majority(q), None).unwrap();
         let sampling = sample(&grid, &SampleOptions::default()).unwrap();
         let min_width = pipeline.auto_min_width(q);
