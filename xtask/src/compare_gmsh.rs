@@ -8,7 +8,10 @@
 //! is stopped after `IMESH_GMSH_TIMEOUT` seconds and reported as failed; `IMESH_SKIP_QQS`
 //! skips it). Its time is the meshing call alone (no classification, no sampling), and again
 //! with building and fragmenting the geometry of G' before it; ours is the whole run, image to
-//! optimised quads.
+//! optimised quads. Both are the better of [`TIMED_RUNS`] runs where a run takes under
+//! [`REPEAT_UNDER`] seconds: the first run of a process pays for its thread pool and the first
+//! touch of its memory (our MRI run: 0.24 s first, 0.08 s after), which on a run of a tenth of a
+//! second is most of the ratio.
 
 use std::io::Write as _;
 use std::process::{Command, Stdio};
@@ -18,6 +21,12 @@ use imesh_geom::predicates::orient2d;
 use imesh_geom::Point;
 use imesh_quality::QuadQuality;
 use serde::{Deserialize, Serialize};
+
+/// Runs timed of each side where one takes under [`REPEAT_UNDER`] seconds: the best counts.
+const TIMED_RUNS: usize = 3;
+
+/// Seconds under which a run is timed again ([`TIMED_RUNS`]).
+const REPEAT_UNDER: f64 = 5.0;
 
 /// The fixtures compared by default: the five label-like ones whose Gmsh runs take seconds
 /// (`--fixtures all` adds the textured four and aloe, whose G' has thousands of curves).
@@ -292,7 +301,17 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
                 imesh_quality::Element::Triangle(_) => None,
             })
             .collect();
-        let our_side = side(&our_vertices, &our_quads, 0, ours.report.seconds.total, 0.0);
+        let mut our_seconds = ours.report.seconds.total;
+        for _ in 1..TIMED_RUNS {
+            if our_seconds >= REPEAT_UNDER {
+                break;
+            }
+            let again = Pipeline::new(options.clone())
+                .run_path(path)
+                .map_err(|e| format!("{file}: {e}"))?;
+            our_seconds = our_seconds.min(again.report.seconds.total);
+        }
+        let our_side = side(&our_vertices, &our_quads, 0, our_seconds, 0.0);
         let target = our_quads.len() as f64;
         let peer = |algorithm: &str| -> Option<Side> {
             // Quads of side lc: about area / lc² (the subdivision splits every element of the
@@ -302,6 +321,7 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
             let full_quad = if algorithm == "blossom" { 2.0 } else { 1.0 };
             let mut lc = full_quad * (w * h / target).sqrt();
             let mut last: Option<GmshMesh> = None;
+            let mut last_spec = serde_json::Value::Null;
             for _ in 0..3 {
                 if let Some(m) = &last {
                     let count = (m.quads.len() + m.triangles.len()) as f64;
@@ -329,6 +349,20 @@ pub fn run(options: MeshOptions, fixtures: &Fixtures) -> Result<(), String> {
                 let count = (m.quads.len() + m.triangles.len()).max(1) as f64;
                 lc *= (count / target).sqrt();
                 last = Some(m);
+                last_spec = spec;
+            }
+            // The kept size again, as ours, where a run is short: the best time counts.
+            if let Some(m) = &mut last {
+                for _ in 1..TIMED_RUNS {
+                    if m.seconds >= REPEAT_UNDER {
+                        break;
+                    }
+                    let Ok(again) = gmsh(&python, &last_spec) else {
+                        break;
+                    };
+                    m.seconds = m.seconds.min(again.seconds);
+                    m.geometry_seconds = m.geometry_seconds.min(again.geometry_seconds);
+                }
             }
             last.map(|m| {
                 side(

@@ -18,6 +18,12 @@
 //! power 1 spreads the gain and left most worst quads where they were; 8 gave astronaut
 //! 0.490 → 0.427).
 //!
+//! The vertices of G' (corners and junctions of the boundaries) are held by the rest of the
+//! optimiser; here, given a reach ([`Reach`], `OptimOptions::corner_reach`), they move too, as
+//! free vertices within that distance of where the optimiser found them, pass after pass: a
+//! quad corner at a G' vertex whose sector it shares with other quads keeps a share of the
+//! sector's angle wherever everything else goes, and only the vertex itself can widen it.
+//!
 //! The same patches lift the quads of poor shape-and-size last ([`Aim::Quality`]): a quad a
 //! third of the mean area at a tip or in a strip grows only if its neighbours give it room, and
 //! they are held there by their own corners and by the energy, in which it is one term among
@@ -68,11 +74,32 @@ pub(crate) const LATER_PASS_QUADS: usize = 64;
 /// that the batches depend on nothing else.
 pub(crate) const BATCH: usize = 32;
 
+/// How far a G' vertex may move ([`repair_jointly`]): within `reach` of `origin`, along the
+/// axes `axes` leaves free (1 free, 0 held: a vertex on the domain's border moves along it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Reach {
+    pub origin: Point,
+    pub reach: f64,
+    pub axes: Point,
+}
+
 /// One moving point of a patch; `at` is its index among the patch's points.
 #[derive(Clone, Copy, Debug)]
 enum Mover {
     /// A free quad vertex at `base`, moved by `scale` times its two variables.
     Free { at: u32, base: Point, scale: f64 },
+    /// A G' vertex (a corner or a junction of the boundaries, which nothing else moves) at
+    /// `base`, moved like a free vertex along the free `axes` of its [`Reach`], never farther
+    /// than `reach` from `origin`, where the optimiser found it (passes and patches after the
+    /// first start where the last left it).
+    Corner {
+        at: u32,
+        base: Point,
+        scale: f64,
+        origin: Point,
+        reach: f64,
+        axes: Point,
+    },
     /// Slider `slider` at `base` along its chain, moved by `scale` times its variable, at least
     /// `margin` from its neighbours along the chain (`ends`).
     Slider {
@@ -202,10 +229,12 @@ impl Aim {
 /// patches fit is checked once all are solved; if it did (never on the fixtures), the pass runs
 /// again from its start, taking the patches only in order ([`Scheduler::in_order`]). Either way
 /// the result is that of solving the patches one after the other.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn repair_jointly<const B: usize>(
     points: &mut [Point],
     around: &Rows<u32>,
     fixed: &[bool],
+    reach: &[Reach],
     sliders: &mut Sliders,
     setup: &Setup,
     aim: Aim,
@@ -243,6 +272,7 @@ pub(crate) fn repair_jointly<const B: usize>(
         let context = Context {
             around,
             fixed,
+            reach,
             slider_of: &slider_of,
             setup,
         };
@@ -441,6 +471,9 @@ struct Candidate {
 struct Context<'a> {
     around: &'a Rows<u32>,
     fixed: &'a [bool],
+    /// Per vertex, how far from where it may move if it is fixed and no slider (a G' vertex);
+    /// empty: none moves.
+    reach: &'a [Reach],
     slider_of: &'a [u32],
     setup: &'a Setup<'a>,
 }
@@ -473,7 +506,9 @@ impl Context<'_> {
             .collect();
         movers.sort_unstable();
         movers.dedup();
-        movers.retain(|&v| !self.fixed[v as usize] || self.slider_of[v as usize] != u32::MAX);
+        movers.retain(|&v| {
+            !self.fixed[v as usize] || self.slider_of[v as usize] != u32::MAX || self.reach(v) > 0.0
+        });
         let mut touched: Vec<u32> = movers
             .iter()
             .flat_map(|&v| self.around.row(v as usize).iter().copied())
@@ -487,7 +522,7 @@ impl Context<'_> {
             .chain(
                 movers
                     .iter()
-                    .filter(|&&v| self.fixed[v as usize])
+                    .filter(|&&v| self.slider_of[v as usize] != u32::MAX)
                     .flat_map(|&v| self.ends(v, sliders).map(|(u, _)| u)),
             )
             .collect();
@@ -499,6 +534,11 @@ impl Context<'_> {
             touched,
             reads,
         }
+    }
+
+    /// How far vertex `v` may move from its origin if it is fixed and no slider.
+    fn reach(&self, v: u32) -> f64 {
+        self.reach.get(v as usize).map_or(0.0, |r| r.reach)
     }
 
     /// The quad vertices before and after slider vertex `v` on its chain, and their sliders.
@@ -521,7 +561,8 @@ impl Context<'_> {
             .map(|&v| {
                 // A mover is a corner of the quads it touches.
                 let at = sub.index(v).unwrap_or(usize::MAX) as u32;
-                if !self.fixed[v as usize] {
+                let free = !self.fixed[v as usize];
+                if free || self.slider_of[v as usize] == u32::MAX {
                     let base = points[v as usize];
                     let (mut sum, mut count) = (0.0, 0usize);
                     for &r in self.around.row(v as usize) {
@@ -532,10 +573,23 @@ impl Context<'_> {
                             }
                         }
                     }
-                    Mover::Free {
-                        at,
-                        base,
-                        scale: sum / count.max(1) as f64,
+                    let scale = sum / count.max(1) as f64;
+                    if free {
+                        Mover::Free { at, base, scale }
+                    } else {
+                        let Reach {
+                            origin,
+                            reach,
+                            axes,
+                        } = self.reach[v as usize];
+                        Mover::Corner {
+                            at,
+                            base,
+                            scale,
+                            origin,
+                            reach,
+                            axes,
+                        }
                     }
                 } else {
                     let slider = self.slider_of[v as usize];
@@ -607,16 +661,29 @@ impl Patch {
 impl Mover {
     /// Its index among its patch's points.
     fn at(&self) -> usize {
-        let (Mover::Free { at, .. } | Mover::Slider { at, .. }) = *self;
+        let (Mover::Free { at, .. } | Mover::Corner { at, .. } | Mover::Slider { at, .. }) = *self;
         at as usize
     }
 
     /// Puts it at its variables, the first of `x` (into `points`, and a slider's position
-    /// along its chain into `along`).
+    /// along its chain into `along`, a corner's squared distance from its origin).
     fn place(&self, x: &[f64], points: &mut [Point], along: &mut f64, sliders: &Sliders) {
         match *self {
             Mover::Free { at, base, scale } => {
                 points[at as usize] = Point::new(base.x + scale * x[0], base.y + scale * x[1]);
+            }
+            Mover::Corner {
+                at,
+                base,
+                scale,
+                origin,
+                axes,
+                ..
+            } => {
+                let (dx, dy) = (axes.x * scale * x[0], axes.y * scale * x[1]);
+                let p = Point::new(base.x + dx, base.y + dy);
+                *along = p.distance_squared(origin);
+                points[at as usize] = p;
             }
             Mover::Slider {
                 slider,
@@ -631,17 +698,19 @@ impl Mover {
         }
     }
 
-    /// Its number of variables: a free vertex's two coordinates, a slider's position.
+    /// Its number of variables: a free vertex's or a corner's two coordinates, a slider's
+    /// position.
     fn variables(&self) -> usize {
         match self {
-            Mover::Free { .. } => 2,
+            Mover::Free { .. } | Mover::Corner { .. } => 2,
             Mover::Slider { .. } => 1,
         }
     }
 }
 
 /// Puts the movers at `x` (into `points`, and each slider's position along its chain into
-/// `along`); false when a slider comes within its margin of a neighbour (or passes it).
+/// `along`); false when a slider comes within its margin of a neighbour (or passes it), or a
+/// corner goes farther than its reach.
 fn place(
     movers: &[Mover],
     x: &[f64],
@@ -658,10 +727,11 @@ fn place(
 }
 
 /// Whether every slider among `movers` (at `along`) is more than its margin from either
-/// neighbour on its chain.
+/// neighbour on its chain, and every corner within its reach.
 fn clear_of_neighbours(movers: &[Mover], along: &[f64]) -> bool {
     movers.iter().zip(along).all(|(m, &at)| match *m {
         Mover::Free { .. } => true,
+        Mover::Corner { reach, .. } => at <= reach * reach,
         Mover::Slider { margin, ends, .. } => {
             let [lo, hi] = ends.map(|end| match end {
                 Along::Held(a) => a,
@@ -779,7 +849,7 @@ fn energy(quads: &[u32], points: &[Point], setup: &Setup) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{repair_jointly, Aim, Budget, Mover, Shortfall};
+    use super::{repair_jointly, Aim, Budget, Mover, Reach, Shortfall};
     use crate::repair::{compass, stalling_grid, REPAIR_FLOOR, REPAIR_JACOBIAN};
     use crate::slide::Sliders;
     use crate::variables::Rows;
@@ -789,7 +859,8 @@ mod tests {
     use proptest::prelude::*;
 
     /// The joint repair, solving a given number of patches side by side.
-    type Repair = fn(&mut [Point], &Rows<u32>, &[bool], &mut Sliders, &Setup, Aim, Budget) -> usize;
+    type Repair =
+        fn(&mut [Point], &Rows<u32>, &[bool], &[Reach], &mut Sliders, &Setup, Aim, Budget) -> usize;
 
     fn corners(quad: &[u32; 4], points: &[Point]) -> [[f64; 2]; 4] {
         quad.map(|v| [points[v as usize].x, points[v as usize].y])
@@ -888,6 +959,73 @@ mod tests {
             .term(q, &quads[q].map(|v| points[v as usize]))
             .is_some()));
         assert!((0..9).all(|v| !fixed[v] || points[v] == before[v]));
+    }
+
+    /// Two quads in a 56° wedge share its tip, a fixed vertex of the boundaries: each keeps a
+    /// 28° corner there whatever their free middle vertex does (the two corners sum to the
+    /// tip's angle). Given a reach, the tip moves into the wedge, which opens both corners past
+    /// 30°, and no farther than its reach; without one it stays, and so does the worst corner.
+    #[test]
+    fn a_corner_with_a_reach_opens_the_quads_sharing_it() {
+        let half = 28f64.to_radians();
+        let (c, s) = (2.0 * half.cos(), 2.0 * half.sin());
+        // The tip, the middle (free), the wedge's sides and the far corners (fixed).
+        let before = vec![
+            Point::new(0.0, 0.0),
+            Point::new(2.0, 0.0),
+            Point::new(c, -s),
+            Point::new(2.6, -0.6),
+            Point::new(c, s),
+            Point::new(2.6, 0.6),
+        ];
+        let quads = vec![[0, 2, 3, 1], [0, 1, 5, 4]];
+        let fixed = [true, false, true, true, true, true];
+        let around = around(&quads, before.len());
+        let floors = floors(&quads, &before);
+        let none = [0.0; 2];
+        let setup = setup(&quads, &floors, &none);
+        let start = worst(&quads, &before, scaled_jacobian);
+        assert!((start - half.sin()).abs() < 1e-9, "{start}");
+        let reach = 0.3;
+        let run = |reach: &[Reach]| {
+            let mut points = before.clone();
+            let mut sliders = Sliders::default();
+            let aim = Aim::Corners(REPAIR_JACOBIAN);
+            let budget = everything(3);
+            let moved = repair_jointly::<{ super::BATCH }>(
+                &mut points,
+                &around,
+                &fixed,
+                reach,
+                &mut sliders,
+                &setup,
+                aim,
+                budget,
+            );
+            (moved, points)
+        };
+        let held = run(&[]);
+        assert!(held.1[0] == before[0]);
+        assert!(worst(&quads, &held.1, scaled_jacobian) <= start + 1e-9);
+        let reaches: Vec<Reach> = before
+            .iter()
+            .enumerate()
+            .map(|(v, &origin)| Reach {
+                origin,
+                reach: if v == 0 { reach } else { 0.0 },
+                axes: Point::new(1.0, 1.0),
+            })
+            .collect();
+        let (moved, points) = run(&reaches);
+        let end = worst(&quads, &points, scaled_jacobian);
+        assert!(
+            moved > 0 && end >= REPAIR_JACOBIAN - 1e-3,
+            "{start} → {end}"
+        );
+        let shift = points[0].distance_squared(before[0]).sqrt();
+        assert!(shift > 0.0 && shift <= reach, "{shift}");
+        assert!(points[0].x > 0.0, "into the wedge: {:?}", points[0]);
+        assert!((2..6).all(|v| points[v] == before[v]));
     }
 
     /// A 7 × 7 grid of unit squares whose middle quad is shrunk to a square 0.4 wide (a
@@ -1036,6 +1174,7 @@ mod tests {
                 points,
                 around,
                 fixed,
+                &[],
                 &mut Sliders::default(),
                 setup,
                 aim,
@@ -1057,6 +1196,7 @@ mod tests {
             points,
             around,
             fixed,
+            &[],
             &mut sliders,
             setup,
             aim,
@@ -1155,7 +1295,7 @@ mod tests {
             let repaired = |slack: f64| {
                 let mut points = before.clone();
                 let mut sliders = Sliders::default();
-                repair_jointly::<{ super::BATCH }>(&mut points, &around, &fixed, &mut sliders, &setup, Aim::Corners(REPAIR_JACOBIAN), Budget { slack, passes: 3, first: usize::MAX, later: 64, graded: usize::MAX });
+                repair_jointly::<{ super::BATCH }>(&mut points, &around, &fixed, &[], &mut sliders, &setup, Aim::Corners(REPAIR_JACOBIAN), Budget { slack, passes: 3, first: usize::MAX, later: 64, graded: usize::MAX });
                 points
             };
             let start = worst(&quads, &points, scaled_jacobian).min(REPAIR_JACOBIAN);

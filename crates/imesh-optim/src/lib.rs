@@ -101,6 +101,19 @@ pub const POLISH_SWEEPS: usize = 2;
 /// 0.147 (a poor quad could no longer shrink to square up).
 pub const KEEP_QUALITY: f64 = 0.25;
 
+/// The default [`OptimOptions::corner_reach`]: about a third of the mean quad side (0.7 px at
+/// the automatic size's 2 px floor, within the 2 px curve tolerance up to quads of 5.7 px).
+/// Measured with `cargo xtask bench random` on seven sets of 150 images (seeds 52, 101, 202,
+/// 404 and 505, and 303 and 52 at `--size 3`) against 0 (the corners held), the vertices on the
+/// border held: quads under 0.5 in shape 63 → 28, 20 and 14 at 0.2, 0.35 and 0.5, in scaled
+/// Jacobian 12 → 3 at each; quads under 0.25 25 360 → 23 055, 22 297 and 21 901; the mean of
+/// the means up on every set, by 0.0002–0.0004 at 0.35; label agreement 0.011–0.024 points
+/// lower, the same at every reach within 0.005. At 0.35 with the border's vertices moving
+/// along it: 12, 1 and 22 105 (aloe's worst shape 0.443 → 0.500: a junction on the border);
+/// on four held-out sets (seeds 606 and 707, 808 at `--size 4`, 909 at 2.5) quads under 0.5
+/// in shape 74 → 35, in scaled Jacobian 6 → 1, under 0.25 16 099 → 14 069.
+pub const CORNER_REACH: f64 = 0.35;
+
 /// The quads whose shape-and-size is under this are lifted by the quality repair
 /// ([`OptimOptions::quality_repair`]): Verdict's acceptable range for shape-and-size starts at
 /// 0.2, the paper's worst quads are 0.21–0.29, issue 8's target for the worst is 0.25.
@@ -249,6 +262,18 @@ pub struct OptimOptions {
     /// in a strip, where it is: it is one term among thousands. Measured with the defaults,
     /// quads under 0.25 before → after: see docs/measurements.md's session-35 paragraph.
     pub quality_repair: bool,
+    /// How far the repair's last steps (`joint.rs`) may move a vertex of G' (a corner of the
+    /// boundaries or a junction of three regions or more; one on the domain's border along it,
+    /// the domain's corners not at all) from where it started, as a share of the mean quad side ([`CORNER_REACH`] by default); 0 holds them
+    /// where they are, as the rest of the optimiser does. Nothing else moves them: a corner
+    /// shared by two quads (a 56° tip split by an edge), or a junction's sectors, keep their
+    /// angles whatever the vertices around them do, and were most of the quads left under 0.5
+    /// in shape or scaled Jacobian (gravel's worst, 0.468 and 0.472: a 56° tip; aloe's 0.461:
+    /// a junction). Moving the tip a fraction of a quad side into the region opens both corners.
+    /// The boundaries beside a moved corner move with it, by its shift at most
+    /// ([`OptimReport::corner_shift`]; the pipeline adds it to the boundary's reported
+    /// Hausdorff distance), and a second-order side there stays straight.
+    pub corner_reach: f64,
 }
 
 impl Default for OptimOptions {
@@ -270,6 +295,7 @@ impl Default for OptimOptions {
             repair: true,
             joint_passes: 3,
             quality_repair: true,
+            corner_reach: CORNER_REACH,
         }
     }
 }
@@ -317,6 +343,11 @@ pub struct OptimReport {
     pub repaired_sliders: usize,
     /// Patches moved for the quality of their poorest quads ([`OptimOptions::quality_repair`]).
     pub quality_repaired: usize,
+    /// Vertices of G' (corners and junctions of the boundaries) the repair moved
+    /// ([`OptimOptions::corner_reach`])...
+    pub moved_corners: usize,
+    /// ... and the farthest one moved, in the mesh's units.
+    pub corner_shift: f64,
     /// The boundary chains with their vertices where sliding left them along the curves, for
     /// second-order sides that follow the curves between them; `None` when the method does not
     /// slide (the vertices are where [`Remesh::boundary_chains`] finds them).
@@ -652,6 +683,11 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         ..
     } = remesh;
     let quads = mesh.quads.clone();
+    // Where the vertices of G' start: only the repair moves them.
+    let corners_at_start: Vec<(usize, Point)> = (dt.graph_vertex.iter().enumerate())
+        .filter(|&(v, &g)| g != imesh_quad::NONE && v < mesh.vertices.len())
+        .map(|(v, _)| (v, mesh.vertices[v]))
+        .collect();
     let (shape_floors, jacobian_floors): (Vec<f64>, Vec<f64>) = quads
         .par_iter()
         .map(|q| {
@@ -811,11 +847,13 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
             // 0.431, brick 0.383 → 0.462, gravel 0.321 → 0.414 and its worst scaled Jacobian
             // 0.484 → 0.500; see the module), pass after pass ([`OptimOptions::joint_passes`]).
             let (around, fixed) = (vertex_quads(mesh), fixed_vertices(t, elements, mesh));
+            let reach = corner_reach(dt, mesh, options.corner_reach * average_area.sqrt());
             let slack = energy_before - setup.energy(&mesh.vertices);
             moved += joint::repair_jointly::<{ joint::BATCH }>(
                 &mut mesh.vertices,
                 &around,
                 &fixed,
+                &reach,
                 &mut sliders,
                 &repair_setup,
                 joint::Aim::Corners(REPAIR_JACOBIAN),
@@ -838,6 +876,7 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
                     &mut mesh.vertices,
                     &around,
                     &fixed,
+                    &reach,
                     &mut sliders,
                     &repair_setup,
                     joint::Aim::Quality {
@@ -869,6 +908,32 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
     mesh.snap_to_border(t, elements);
     let energy_after = setup.energy(&mesh.vertices);
     let (after, histograms_after) = measure(&mesh.vertices, &mesh.quads);
+    let slider_count = sliders.len();
+    let moved: Vec<(usize, f64)> = corners_at_start
+        .iter()
+        .map(|&(v, p)| (v, mesh.vertices[v].distance_squared(p).sqrt()))
+        .filter(|&(_, d)| d > 0.0)
+        .collect();
+    let corner_shift = moved.iter().map(|&(_, d)| d).fold(0.0, f64::max);
+    // A moved corner is off its chains' ends: the sides beside it leave the chains (a
+    // second-order side there stays straight).
+    let boundary = sliding.then(|| {
+        let mut chains = sliders.into_chains();
+        if !moved.is_empty() {
+            let mut off = vec![false; mesh.vertices.len()];
+            for &(v, _) in &moved {
+                off[v] = true;
+            }
+            for c in &mut chains {
+                let kept: Vec<(u32, f64)> = (c.vertices.iter().zip(&c.along))
+                    .filter(|&(&v, _)| !off[v as usize])
+                    .map(|(&v, &a)| (v, a))
+                    .collect();
+                (c.vertices, c.along) = kept.into_iter().unzip();
+            }
+        }
+        chains
+    });
     Ok(OptimReport {
         method: options.method,
         metric: options.metric,
@@ -878,17 +943,60 @@ pub fn optimise(remesh: &mut Remesh, options: &OptimOptions) -> Result<OptimRepo
         energy_before,
         energy_after,
         sweeps,
-        sliders: sliders.len(),
-        boundary: sliding.then(|| sliders.into_chains()),
+        sliders: slider_count,
+        boundary,
         repaired,
         repaired_sliders,
         quality_repaired,
+        moved_corners: moved.len(),
+        corner_shift,
         seconds: clock.elapsed().as_secs_f64(),
         before,
         after,
         histograms_before,
         histograms_after,
     })
+}
+
+/// Per quad vertex, how far the repair may move it ([`OptimOptions::corner_reach`]): `reach`
+/// from where it is for a vertex of G', along the domain's border for one on it, nothing for
+/// the rest and the domain's corners (empty when `reach` is 0). The border is where the mesh's
+/// extreme coordinates are: its vertices there were put exactly on it, and a vertex moving
+/// along it keeps that coordinate to the bit.
+fn corner_reach(
+    dt: &imesh_quad::RegionTriangulation,
+    mesh: &imesh_quad::QuadMesh,
+    reach: f64,
+) -> Vec<joint::Reach> {
+    if reach <= 0.0 {
+        return Vec::new();
+    }
+    let (mut lo, mut hi) = (
+        Point::new(f64::INFINITY, f64::INFINITY),
+        Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for p in &mesh.vertices {
+        lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    (0..mesh.vertices.len())
+        .map(|v| {
+            let origin = mesh.vertices[v];
+            let graph = dt
+                .graph_vertex
+                .get(v)
+                .is_some_and(|&g| g != imesh_quad::NONE);
+            // An axis is held where the vertex is on a side across it.
+            let free = |c: f64, lo: f64, hi: f64| if c == lo || c == hi { 0.0 } else { 1.0 };
+            let axes = Point::new(free(origin.x, lo.x, hi.x), free(origin.y, lo.y, hi.y));
+            let moves = graph && (axes.x > 0.0 || axes.y > 0.0);
+            joint::Reach {
+                origin,
+                reach: if moves { reach } else { 0.0 },
+                axes,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

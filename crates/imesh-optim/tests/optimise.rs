@@ -122,7 +122,14 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
     }
     let (controls, vertices) = constrained(start);
     let sliding = matches!(method, Method::Local | Method::Vertex) && options.slide;
-    for v in vertices {
+    let graph_vertex = |v: usize| {
+        start
+            .dt
+            .graph_vertex
+            .get(v)
+            .is_some_and(|&g| g != imesh_quad::NONE)
+    };
+    for v in vertices.into_iter().filter(|&v| !graph_vertex(v)) {
         let (was, is) = (start.mesh.vertices[v], r.mesh.vertices[v]);
         if sliding && is != was {
             assert!(
@@ -133,12 +140,52 @@ fn check(start: &Remesh, method: Method, metric: Metric) -> (Remesh, OptimReport
             assert_eq!(is, was, "{method:?} moved vertex {v}");
         }
     }
-    // G' vertices (junctions, corners) never move, sliding or not.
-    for (v, &gv) in start.dt.graph_vertex.iter().enumerate() {
-        if gv != imesh_quad::NONE {
-            assert_eq!(r.mesh.vertices[v], start.mesh.vertices[v], "G' vertex {v}");
+    // G' vertices (junctions, corners) move only in the repair of the local and vertex modes,
+    // at most their reach from where they were, along the domain's border for one on it, and
+    // never at the domain's corners.
+    let repairs = options.repair && matches!(method, Method::Local | Method::Vertex);
+    let reach = if repairs {
+        options.corner_reach * report.average_area.sqrt() * (1.0 + 1e-9)
+    } else {
+        0.0
+    };
+    let (lo, hi) = start.mesh.vertices.iter().fold(
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
+    );
+    let (mut moved, mut farthest) = (0, 0.0f64);
+    for v in (0..start.dt.graph_vertex.len()).filter(|&v| graph_vertex(v)) {
+        let (was, is) = (start.mesh.vertices[v], r.mesh.vertices[v]);
+        let d = was.distance_squared(is).sqrt();
+        let (on_x, on_y) = (
+            was.x == lo.x || was.x == hi.x,
+            was.y == lo.y || was.y == hi.y,
+        );
+        assert!(
+            d == 0.0 || (d <= reach && !(on_x && on_y)),
+            "{method:?}: G' vertex {v} moved {d} (reach {reach})"
+        );
+        assert!(
+            (!on_x || is.x == was.x) && (!on_y || is.y == was.y),
+            "{method:?}: G' vertex {v} left the border"
+        );
+        if d > 0.0 {
+            (moved, farthest) = (moved + 1, farthest.max(d));
         }
     }
+    assert_eq!(
+        (report.moved_corners, report.corner_shift),
+        (moved, farthest),
+        "{method:?}"
+    );
     if matches!(method, Method::Local | Method::Global) {
         for c in controls {
             assert_eq!(

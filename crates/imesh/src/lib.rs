@@ -471,6 +471,11 @@ pub struct MeshOptions {
     /// ([`imesh_curves::blunt_sharp_tips`], uniform quads only): the quad at such a tip has a
     /// corner that sharp, a scaled Jacobian under 0.5.
     pub keep_sharp_tips: bool,
+    /// How far the optimiser's last repairs may move a corner or a junction of the boundaries
+    /// (a vertex of G' off the image's border), as a share of the mean quad side, to open a
+    /// corner that a quad there must otherwise keep under 30° or to give a small quad room; 0
+    /// keeps every one where the boundaries put it ([`imesh_optim::OptimOptions::corner_reach`]).
+    pub corner_reach: f64,
 }
 
 /// Default [`MeshOptions::max_elements`]: five million elements (about 1.5 GB at the peak of a
@@ -505,6 +510,7 @@ impl Default for MeshOptions {
             max_labels: imesh_classify::DEFAULT_MAX_LABELS,
             max_elements: DEFAULT_MAX_ELEMENTS,
             keep_sharp_tips: false,
+            corner_reach: imesh_optim::CORNER_REACH,
         }
     }
 }
@@ -738,6 +744,11 @@ pub struct Optimisation {
     pub repaired_sliders: usize,
     /// Patches moved last for the quality of their poorest quads.
     pub quality_repaired: usize,
+    /// Corners and junctions of the boundaries those last repairs moved
+    /// ([`MeshOptions::corner_reach`])...
+    pub moved_corners: usize,
+    /// ... and the farthest one moved, in pixels.
+    pub corner_shift_px: f64,
 }
 
 /// Quality histograms of the quads before and after optimisation (20 bins over [0, 1]), as the
@@ -1171,6 +1182,9 @@ impl Pipeline {
         report.input.width = original.width();
         report.input.height = original.height();
         report.fidelity.boundary_hausdorff_px *= sx.max(sy);
+        if let Some(o) = &mut report.optimisation {
+            o.corner_shift_px *= sx.max(sy);
+        }
         let mesh = &*mesh;
         let (area_ratio, (quality, label_agreement)) = rayon::join(
             || area_ratio(mesh, w, h),
@@ -1766,12 +1780,15 @@ impl Pipeline {
                     MetricName::Shape => Metric::Shape,
                 },
                 global_iterations: o.global_iterations,
+                corner_reach: o.corner_reach,
                 ..OptimOptions::default()
             },
         )?;
         seconds.optimise = optimisation.seconds;
         *optimised = Some(QuadExtras {
-            hausdorff: fits.max_error.max(fits.max_curve_deviation).max(tip_moved),
+            // A corner the repair moved takes the boundary beside it that far at most.
+            hausdorff: fits.max_error.max(fits.max_curve_deviation).max(tip_moved)
+                + optimisation.corner_shift,
             optimisation: Optimisation {
                 method: o.optimizer,
                 metric: o.metric,
@@ -1784,6 +1801,8 @@ impl Pipeline {
                 repaired: optimisation.repaired,
                 repaired_sliders: optimisation.repaired_sliders,
                 quality_repaired: optimisation.quality_repaired,
+                moved_corners: optimisation.moved_corners,
+                corner_shift_px: optimisation.corner_shift,
             },
             before: optimisation.before,
             histograms: QualityHistograms {
@@ -1961,6 +1980,13 @@ impl Pipeline {
             return Err(PipelineError::Options(format!(
                 "the smallest part width must be a distance in pixels ≥ 0 (0 keeps every part), \
                  not {w}"
+            )));
+        }
+        if !(o.corner_reach.is_finite() && (0.0..=1.0).contains(&o.corner_reach)) {
+            return Err(PipelineError::Options(format!(
+                "the corner reach must be a share of the quad side from 0 (corners stay where \
+                 the boundaries put them) to 1, not {}",
+                o.corner_reach
             )));
         }
         if let Some(t) = o.tolerance.filter(|t| !(t.is_finite() && *t >= 0.0)) {

@@ -158,6 +158,11 @@ struct MeshFlags {
     /// (uniform quads; the report's counts.blunted_tips and blunted_area_px).
     #[arg(long)]
     keep_sharp_tips: bool,
+    /// How far the optimiser may move a corner or a junction of the boundaries (off the image's
+    /// border) to open a corner under 30° or give a small quad room, as a share of the quad
+    /// side; 0 keeps them where the boundaries put them [default: 0.35].
+    #[arg(long)]
+    corner_reach: Option<f64>,
     /// Mesh a reduced grid whose cells are the most common label of about F × F pixels, then
     /// scale the mesh back: auto (uniform quads 8 px wide or more, e.g. a large image or a
     /// large --size: F makes them 4 to 8 cells wide), 1 (never) or F. Options given in pixels
@@ -335,6 +340,9 @@ fn options(args: &MeshFlags) -> Result<MeshOptions, String> {
     }
     if args.keep_sharp_tips {
         o.keep_sharp_tips = true;
+    }
+    if let Some(r) = args.corner_reach {
+        o.corner_reach = r;
     }
     if let Some(e) = args.elements {
         o.elements = e;

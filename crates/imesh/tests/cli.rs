@@ -139,11 +139,15 @@ fn mesh_writes_a_gmsh_file_a_picture_and_a_report() {
     let hausdorff = report["fidelity"]["boundary_hausdorff_px"]
         .as_f64()
         .unwrap();
-    // Within the 2 px tolerance, but where a sharp tip was cut off: as far as the cut.
+    // Within the 2 px tolerance, but where a sharp tip was cut off: as far as the cut; and
+    // where the optimiser moved a corner, that much farther.
     let cut = report["counts"]["blunted_depth_px"].as_f64().unwrap();
+    let shift = report["optimisation"]["corner_shift_px"].as_f64().unwrap();
+    let quad = report["counts"]["quad_size"].as_f64().unwrap();
+    assert!(shift <= 1.1 * imesh_optim::CORNER_REACH * quad, "{shift}");
     assert!(
-        hausdorff > 0.0 && hausdorff <= 2f64.max(cut) + 1e-9,
-        "within the 2 px tolerance or the cut: {hausdorff}"
+        hausdorff > 0.0 && hausdorff <= 2f64.max(cut) + shift + 1e-9,
+        "within the 2 px tolerance or the cut, and the corners' shift: {hausdorff}"
     );
     let seconds = &report["timings_s"];
     let stage = |name: &str| {
@@ -460,6 +464,8 @@ fn bad_input_is_a_clear_error_with_exit_code_2_and_no_file() {
             &["mesh", image, "--min-part-width=-2"],
             "smallest part width",
         ),
+        (&["mesh", image, "--corner-reach", "2"], "corner reach"),
+        (&["mesh", image, "--corner-reach=-0.1"], "corner reach"),
         (&["mesh", image, "--reduction", "0"], "a reduction of 0"),
         (&["mesh", image, "--origin", "5"], "give X,Y"),
         (&["mesh", image, "--msh-version", "3"], "4.1"),
@@ -922,9 +928,10 @@ fn the_svg_can_be_drawn_over_the_input_image() {
 }
 
 /// The note on a forced worst corner appears only for a corner sharper than 30°: MRI's spike tip
-/// (27.0°) when its sharp tips and thin parts are kept, not a square region's right angles. By
-/// default the spike, thinner than a quad, goes with the thin parts; with them kept, the tip
-/// is cut off, and the command says so.
+/// (27.0°) when its sharp tips and thin parts are kept and its corners held where they are
+/// (`--corner-reach 0`), not a square region's right angles. By default the spike, thinner than
+/// a quad, goes with the thin parts; with them kept, the tip is cut off, and the command says
+/// so.
 #[test]
 fn the_forced_corner_note_names_only_sharp_corners() {
     let dir = tempfile::tempdir().unwrap();
@@ -939,6 +946,8 @@ fn the_forced_corner_note_names_only_sharp_corners() {
             "mri.msh",
             "--keep-sharp-tips",
             "--min-part-width",
+            "0",
+            "--corner-reach",
             "0",
         ],
         dir.path(),

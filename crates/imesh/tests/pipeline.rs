@@ -641,8 +641,8 @@ fn a_thin_arm_between_two_wide_parts_goes_to_its_neighbour() {
 
 /// Under a reduction the options given in pixels are converted to cells, the defaults apply to
 /// the cells: a 2 px tolerance keeps the boundaries within 2 px of the image's, the default
-/// within 2 cells. (Graded: no quad-sized joining of short pieces, so the tolerance is the
-/// bound.)
+/// within 2 cells, each beyond that by the farthest the optimiser moved a corner, in pixels too.
+/// (Graded: no quad-sized joining of short pieces, so the tolerance is the bound.)
 #[test]
 fn options_given_in_pixels_stay_in_pixels_on_a_reduced_grid() {
     let path = support::fixture("stardist-mask2d_labels.png");
@@ -658,12 +658,23 @@ fn options_given_in_pixels_stay_in_pixels_on_a_reduced_grid() {
     let given = run(Some(2.0));
     let default = run(None);
     let hausdorff = |r: &imesh::Report| r.fidelity.boundary_hausdorff_px;
+    let shift = |r: &imesh::Report| r.optimisation.as_ref().unwrap().corner_shift_px;
     assert_eq!(given.counts.reduction, 4);
     assert_eq!(given.options.tolerance, Some(2.0));
-    assert!(hausdorff(&given) > 0.0 && hausdorff(&given) <= 2.0 + 1e-9);
+    assert!(hausdorff(&given) > 0.0 && hausdorff(&given) <= 2.0 + shift(&given) + 1e-9);
     // The default: 2 cells of 4 px, reported as used.
     assert_eq!(default.options.tolerance, Some(8.0));
-    assert!(hausdorff(&default) > 2.0 && hausdorff(&default) <= 8.0 + 1e-9);
+    assert!(hausdorff(&default) > 2.0 && hausdorff(&default) <= 8.0 + shift(&default) + 1e-9);
+    // A corner moves by a share of the mean quad side at most, the cells scaled to pixels.
+    for r in [&given, &default] {
+        let side =
+            (f64::from(r.counts.width) * f64::from(r.counts.height) / r.counts.quads as f64).sqrt();
+        assert!(
+            shift(r) <= imesh_optim::CORNER_REACH * side * (1.0 + 1e-9),
+            "{}",
+            shift(r)
+        );
+    }
     assert!(default.counts.quads < given.counts.quads);
 }
 
@@ -699,13 +710,16 @@ fn the_mesh_and_the_report_are_the_same_on_one_and_two_threads() {
 /// open) are cut off where they are a quad side or two wide: the worst scaled Jacobian reaches
 /// 0.5 instead of the tips' sine, for a few pixels given to the neighbour region. (With the
 /// defaults the spikes, thinner than a quad, go with the thin parts first; here those are
-/// kept.)
+/// kept.) Kept, a tip stays as sharp only with its corners held (`corner_reach` 0): by default
+/// the optimiser moves the tip's vertex a fraction of a quad side into the spike, which opens
+/// it to 30° and cuts nothing off.
 #[test]
 fn sharp_tips_are_cut_unless_kept() {
     let path = support::fixture("matplotlib-s1045_mri.png");
-    let run = |keep_sharp_tips: bool| {
+    let run = |keep_sharp_tips: bool, corner_reach: f64| {
         Pipeline::new(MeshOptions {
             keep_sharp_tips,
+            corner_reach,
             min_part_width: Some(0.0),
             ..MeshOptions::default()
         })
@@ -713,7 +727,7 @@ fn sharp_tips_are_cut_unless_kept() {
         .unwrap()
         .report
     };
-    let (cut, kept) = (run(false), run(true));
+    let (cut, kept) = (run(false, 0.0), run(true, 0.0));
     assert!(cut.validation.valid && kept.validation.valid);
     assert_eq!(kept.counts.blunted_tips, 0);
     assert!(cut.counts.blunted_tips > 0 && cut.counts.blunted_area_px > 0.0);
@@ -725,6 +739,24 @@ fn sharp_tips_are_cut_unless_kept() {
     assert!((kept.label_agreement - cut.label_agreement).abs() < 1e-3);
     // The boundary moved by the cut's depth at most, and the report's fidelity says so.
     assert!(cut.fidelity.boundary_hausdorff_px >= kept.fidelity.boundary_hausdorff_px);
+    // Kept, with the corners free to move by default: nothing cut off, the tips opened.
+    let opened = run(true, imesh_optim::CORNER_REACH);
+    assert!(opened.validation.valid);
+    assert_eq!(opened.counts.blunted_tips, 0);
+    assert!(sj(&opened) >= 0.5 - 1e-9, "{}", sj(&opened));
+    let moves = opened.optimisation.as_ref().unwrap();
+    let reach = imesh_optim::CORNER_REACH * opened.counts.quad_size;
+    assert!(moves.moved_corners > 0 && moves.corner_shift_px > 0.0);
+    // The mean quad side is within a few percent of the chosen size.
+    assert!(
+        moves.corner_shift_px <= 1.1 * reach,
+        "{moves:?}, reach {reach}"
+    );
+    assert!(
+        opened.fidelity.boundary_hausdorff_px
+            >= kept.fidelity.boundary_hausdorff_px + moves.corner_shift_px - 1e-9
+    );
+    assert!((kept.label_agreement - opened.label_agreement).abs() < 1e-3);
 }
 
 /// `--order 2` on a fixture of curved boundaries, meshed on its pixels and on a reduced grid
