@@ -5,7 +5,7 @@
 //! cargo xtask bench refine [--runs N]
 //! cargo xtask bench optim [--global-iterations N]
 //! cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-//! cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--images DIR]
+//! cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--corner-reach R] [--images DIR]
 //! cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
 //! cargo xtask fixtures [points | quality]
 //! cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -27,7 +27,7 @@ const USAGE: &str = "usage: cargo xtask bench delaunay [--runs N] [--quick]
        cargo xtask bench refine [--runs N]
        cargo xtask bench optim [--global-iterations N]
        cargo xtask bench pipeline [--scaling-max SIDE] [--readme]
-       cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--images DIR]
+       cargo xtask bench random [--count N] [--seed S] [--size S] [--optimizer M] [--corner-reach R] [--images DIR]
        cargo xtask compare gmsh [--size auto|graded|PX] [--fixtures all|NAME,...]
        cargo xtask fixtures [points | quality]
        cargo xtask fuzz [TARGET ...] [--seconds N]
@@ -163,6 +163,12 @@ fn run(args: &[String]) -> Result<(), String> {
                     ["--size", size, more @ ..] => (options.size, rest) = (size.parse()?, more),
                     ["--optimizer", method, more @ ..] => {
                         (options.optimizer, rest) = (method.parse()?, more);
+                    }
+                    ["--corner-reach", share, more @ ..] => {
+                        options.corner_reach = share.parse().map_err(|_| {
+                            format!("--corner-reach takes a share of the quad side, not '{share}'")
+                        })?;
+                        rest = more;
                     }
                     ["--images", dir, more @ ..] => {
                         (images, rest) = (Some(std::path::PathBuf::from(dir)), more);
