@@ -486,7 +486,7 @@ struct Patch {
 }
 
 /// Where a solved patch's points went, and its movers along their chains (a free one's entry
-/// unused), and the energy that added.
+/// unused, a corner's its squared distance from its origin), and the energy that added.
 struct Outcome {
     points: Vec<Point>,
     along: Vec<f64>,
